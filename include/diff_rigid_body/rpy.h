@@ -1,0 +1,156 @@
+// Euler-angle (roll-pitch-yaw) kinematics, templated on the scalar type.
+//
+// Convention (URDF rpy, tf2::Matrix3x3::setRPY):
+//   r = (phi, theta, psi)            [rad]
+//   R(r) = Rz(psi) * Ry(theta) * Rx(phi)
+// i.e. intrinsic rotations Z, then Y', then X''.
+//
+// The kernels work for double, float, std::complex<double> (complex-step
+// derivatives) and mpfr::mpreal (high-precision reference). Math functions
+// are called unqualified so that argument-dependent lookup picks the
+// scalar's own sin/cos.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <complex>
+
+#include <Eigen/Core>
+
+namespace diff_rigid_body
+{
+template <typename Scalar>
+using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
+template <typename Scalar>
+using Vector6 = Eigen::Matrix<Scalar, 6, 1>;
+template <typename Scalar>
+using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
+template <typename Scalar>
+using Matrix6 = Eigen::Matrix<Scalar, 6, 6>;
+template <typename Scalar>
+using Matrix36 = Eigen::Matrix<Scalar, 3, 6>;
+
+/// Indices into q = (phi, theta, psi, tx, ty, tz).
+enum StateIndex : int
+{
+  PHI = 0,
+  THETA = 1,
+  PSI = 2,
+  TX = 3,
+  TY = 4,
+  TZ = 5
+};
+
+/// Sines and cosines of the three RPY angles, computed once per state so that
+/// every kernel below can share them (trigonometry once per body, never per
+/// vertex).
+template <typename Scalar>
+struct RpyTrig
+{
+  Scalar s_phi, c_phi, s_theta, c_theta, s_psi, c_psi;
+
+  RpyTrig(const Scalar& phi, const Scalar& theta, const Scalar& psi)
+  {
+    using std::cos;
+    using std::sin;
+    s_phi = sin(phi);
+    c_phi = cos(phi);
+    s_theta = sin(theta);
+    c_theta = cos(theta);
+    s_psi = sin(psi);
+    c_psi = cos(psi);
+  }
+
+  template <typename Derived>
+  explicit RpyTrig(const Eigen::MatrixBase<Derived>& q) : RpyTrig(q[PHI], q[THETA], q[PSI])
+  {
+  }
+};
+
+/// R = Rz(psi) Ry(theta) Rx(phi), the rotation from the body axes to the fixed frame.
+template <typename Scalar>
+Matrix3<Scalar> rpyToMatrix(const RpyTrig<Scalar>& t)
+{
+  Matrix3<Scalar> R;
+  R(0, 0) = t.c_theta * t.c_psi;
+  R(0, 1) = -t.c_phi * t.s_psi + t.s_phi * t.s_theta * t.c_psi;
+  R(0, 2) = t.s_phi * t.s_psi + t.c_phi * t.s_theta * t.c_psi;
+  R(1, 0) = t.c_theta * t.s_psi;
+  R(1, 1) = t.c_phi * t.c_psi + t.s_phi * t.s_theta * t.s_psi;
+  R(1, 2) = -t.s_phi * t.c_psi + t.c_phi * t.s_theta * t.s_psi;
+  R(2, 0) = -t.s_theta;
+  R(2, 1) = t.s_phi * t.c_theta;
+  R(2, 2) = t.c_phi * t.c_theta;
+  return R;
+}
+
+template <typename Scalar>
+Matrix3<Scalar> rpyToMatrix(const Scalar& phi, const Scalar& theta, const Scalar& psi)
+{
+  return rpyToMatrix(RpyTrig<Scalar>(phi, theta, psi));
+}
+
+/// T(r): maps Euler-angle rates to the angular velocity in the fixed frame,
+/// omega = T(r) * rdot. Its columns are the world directions of the X'', Y'
+/// and Z rotation axes:
+///   T = [[cos th cos psi, -sin psi, 0],
+///        [cos th sin psi,  cos psi, 0],
+///        [-sin th,         0,       1]]
+template <typename Scalar>
+Matrix3<Scalar> angularVelocityMatrixWorld(const RpyTrig<Scalar>& t)
+{
+  Matrix3<Scalar> T;
+  T << t.c_theta * t.c_psi, -t.s_psi, Scalar(0),  //
+      t.c_theta * t.s_psi, t.c_psi, Scalar(0),    //
+      -t.s_theta, Scalar(0), Scalar(1);
+  return T;
+}
+
+/// A(phi, theta) = R^T T: maps Euler-angle rates to the angular velocity in
+/// body axes, omega_b = A * rdot. Independent of psi.
+///   A = [[1,  0,        -sin th        ],
+///        [0,  cos phi,   sin phi cos th],
+///        [0, -sin phi,   cos phi cos th]]
+template <typename Scalar>
+Matrix3<Scalar> angularVelocityMatrixBody(const RpyTrig<Scalar>& t)
+{
+  Matrix3<Scalar> A;
+  A << Scalar(1), Scalar(0), -t.s_theta,            //
+      Scalar(0), t.c_phi, t.s_phi * t.c_theta,      //
+      Scalar(0), -t.s_phi, t.c_phi * t.c_theta;
+  return A;
+}
+
+/// dA/dphi and dA/dtheta (dA/dpsi = 0).
+template <typename Scalar>
+std::array<Matrix3<Scalar>, 2> angularVelocityMatrixBodyDerivatives(const RpyTrig<Scalar>& t)
+{
+  std::array<Matrix3<Scalar>, 2> dA;
+  dA[0] << Scalar(0), Scalar(0), Scalar(0),           //
+      Scalar(0), -t.s_phi, t.c_phi * t.c_theta,       //
+      Scalar(0), -t.c_phi, -t.s_phi * t.c_theta;
+  dA[1] << Scalar(0), Scalar(0), -t.c_theta,          //
+      Scalar(0), Scalar(0), -t.s_phi * t.s_theta,     //
+      Scalar(0), Scalar(0), -t.c_phi * t.s_theta;
+  return dA;
+}
+
+/// dR/dphi, dR/dtheta, dR/dpsi, by the product rule on the elementary rotations:
+///   dR/dphi = Rz Ry Rx',  dR/dtheta = Rz Ry' Rx,  dR/dpsi = Rz' Ry Rx.
+/// Equivalently dR/dr_k = [T_k]_x R, with T_k the k-th column of T.
+template <typename Scalar>
+std::array<Matrix3<Scalar>, 3> rpyToMatrixDerivatives(const RpyTrig<Scalar>& t)
+{
+  const Matrix3<Scalar> R = rpyToMatrix(t);
+  const Matrix3<Scalar> T = angularVelocityMatrixWorld(t);
+  std::array<Matrix3<Scalar>, 3> dR;
+  for (int k = 0; k < 3; ++k)
+  {
+    const Vector3<Scalar> axis = T.col(k);
+    for (int c = 0; c < 3; ++c)
+      dR[k].col(c) = axis.cross(R.col(c));
+  }
+  return dR;
+}
+
+}  // namespace diff_rigid_body

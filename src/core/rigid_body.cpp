@@ -1,0 +1,70 @@
+#include "diff_rigid_body/rigid_body.h"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <sstream>
+
+#include <Eigen/Eigenvalues>
+
+#include "diff_rigid_body/exceptions.h"
+
+namespace diff_rigid_body
+{
+namespace
+{
+std::string formatMatrix(const Eigen::Matrix3d& m)
+{
+  std::ostringstream out;
+  out.precision(17);
+  out << "[[" << m(0, 0) << ", " << m(0, 1) << ", " << m(0, 2) << "], [" << m(1, 0) << ", " << m(1, 1) << ", "
+      << m(1, 2) << "], [" << m(2, 0) << ", " << m(2, 1) << ", " << m(2, 2) << "]]";
+  return out.str();
+}
+}  // namespace
+
+void validateMassProperties(const std::string& where, double mass, const Eigen::Matrix3d& inertia)
+{
+  std::ostringstream why;
+  why.precision(17);
+  if (!std::isfinite(mass))
+  {
+    why << where << ": mass must be finite, got " << mass;
+    throw InvalidInertiaError(why.str());
+  }
+  if (!(mass > 0.0))
+  {
+    why << where << ": mass must be > 0 kg, got " << mass;
+    throw InvalidInertiaError(why.str());
+  }
+  if (!inertia.allFinite())
+  {
+    why << where << ": inertia must be finite, got " << formatMatrix(inertia);
+    throw InvalidInertiaError(why.str());
+  }
+  const double scale = std::max(1.0, inertia.cwiseAbs().maxCoeff());
+  const double asymmetry = (inertia - inertia.transpose()).cwiseAbs().maxCoeff();
+  if (asymmetry > kInertiaSymmetryTolerance * scale)
+  {
+    why << where << ": inertia must be symmetric, but |I - I^T| = " << asymmetry << " in " << formatMatrix(inertia);
+    throw InvalidInertiaError(why.str());
+  }
+  const Eigen::Matrix3d symmetric = 0.5 * (inertia + inertia.transpose());
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(symmetric, Eigen::EigenvaluesOnly);
+  const Eigen::Vector3d moments = solver.eigenvalues();  // ascending
+  if (!(moments[0] > 0.0))
+  {
+    why << where << ": inertia must be positive-definite, but its smallest principal moment is " << moments[0]
+        << " kg m^2 in " << formatMatrix(inertia);
+    throw InvalidInertiaError(why.str());
+  }
+  const double eps = 16.0 * DBL_EPSILON * std::max(1.0, moments.sum() / 2.0);
+  if (moments[0] + moments[1] < moments[2] - eps)
+  {
+    why << where << ": principal moments break the triangle inequality I1 + I2 >= I3: " << moments[0] << " + "
+        << moments[1] << " < " << moments[2] << " kg m^2";
+    throw InvalidInertiaError(why.str());
+  }
+}
+
+}  // namespace diff_rigid_body
