@@ -16,6 +16,7 @@
 #include <complex>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>  // cross products
 
 namespace diff_rigid_body
 {
@@ -151,6 +152,23 @@ std::array<Matrix3<Scalar>, 3> rpyToMatrixDerivatives(const RpyTrig<Scalar>& t)
       dR[k].col(c) = axis.cross(R.col(c));
   }
   return dR;
+}
+
+/// Inverse of rpyToMatrix for a proper rotation: (phi, theta, psi) with
+/// theta in [-pi/2, pi/2] and phi, psi in (-pi, pi]. At gimbal lock
+/// (cos theta = 0) only phi -+ psi is determined; psi = 0 is chosen.
+inline Vector3<double> matrixToRpy(const Matrix3<double>& R)
+{
+  const double cos_theta = std::hypot(R(0, 0), R(1, 0));
+  const double theta = std::atan2(-R(2, 0), cos_theta);
+  const double psi = cos_theta > 1e-12 ? std::atan2(R(1, 0), R(0, 0)) : 0.0;
+  // phi from Rz(psi)^T R = Ry(theta) Rx(phi), whose middle row is
+  // (0, cos phi, -sin phi). Taking phi consistent with the psi actually chosen
+  // keeps R -> rpy -> R accurate to rounding near the lock; atan2(R21, R22)
+  // alone would lose eps / cos(theta) (1e-3 at cos theta = 1e-12).
+  const double s_psi = std::sin(psi), c_psi = std::cos(psi);
+  const double phi = std::atan2(s_psi * R(0, 2) - c_psi * R(1, 2), c_psi * R(1, 1) - s_psi * R(0, 1));
+  return { phi, theta, psi };
 }
 
 }  // namespace diff_rigid_body

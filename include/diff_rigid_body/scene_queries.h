@@ -1,0 +1,109 @@
+// The queries the node serves, on plain arrays: request validation, state
+// snapshots and evaluation. ROS-free, so that the service logic is unit-tested
+// and fuzzed without a master; the node only copies message fields in and out.
+//
+// Every function validates its whole request before it allocates or writes
+// anything, and throws InvalidArgumentError naming the field, index or body.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "diff_rigid_body/urdf_scene.h"
+
+namespace diff_rigid_body
+{
+/// Documented request limits; a request over one is refused before anything
+/// is allocated for it.
+struct RequestLimits
+{
+  /// Vertices in one get_vertex_jacobians or backprop request (positions and
+  /// Jacobians of 2^22 vertices take 640 MiB).
+  static constexpr std::size_t kMaxVertices = std::size_t(1) << 22;
+  /// Mass matrices (configurations x bodies) in one get_mass_matrix request;
+  /// with derivatives each costs 252 doubles (2 KiB).
+  static constexpr std::size_t kMaxMassMatrices = 1000000;
+  static constexpr std::size_t kMaxMassMatricesWithDerivatives = 100000;
+  /// Entries in one set_state or get_state request.
+  static constexpr std::size_t kMaxStates = 100000;
+};
+
+/// One state q = (phi, theta, psi, tx, ty, tz) per body, in scene order.
+using SceneState = std::vector<Vector6<double>>;
+
+/// Named state of one body, as requests carry it.
+struct NamedState
+{
+  std::string name;
+  Vector6<double> q = Vector6<double>::Zero();
+};
+
+struct MassMatrixAnswer
+{
+  std::vector<std::string> bodies;
+  std::vector<double> mass_matrices;  ///< 36 per matrix, row-major, matrix (k n + i) for configuration k, body i
+  std::vector<double> derivatives;    ///< 216 per matrix when asked: dM/dq_j, j = 0..5, 36 row-major each
+  std::vector<double> cos_theta;      ///< one per matrix
+};
+
+class SceneQueries
+{
+public:
+  explicit SceneQueries(Scene scene);
+
+  const Scene& scene() const { return scene_; }
+  std::size_t bodyCount() const { return scene_.bodies.size(); }
+  const RigidBody& body(std::size_t index) const { return scene_.bodies[index].body; }
+
+  /// The URDF initial state of every body.
+  SceneState initialState() const;
+
+  /// Index of body `name`; throws naming `field` and the known bodies.
+  std::size_t bodyIndex(const std::string& name, const std::string& field) const;
+
+  /// Indices of `names` (empty = all bodies, in scene order).
+  std::vector<std::size_t> bodyIndices(const std::vector<std::string>& names, const std::string& field) const;
+
+  /// The state after applying `updates` to `current`, all or nothing: an
+  /// unknown or repeated name or a non-finite value rejects the whole request.
+  /// q is stored bit for bit (no angle wrapping).
+  SceneState applyStates(const SceneState& current, const std::vector<NamedState>& updates) const;
+
+  /// States of `names` (empty = all).
+  std::vector<NamedState> getStates(const SceneState& current, const std::vector<std::string>& names) const;
+
+  /// M(q), and dM/dq when `derivatives`, for the bodies `names` (empty = all)
+  /// at K configurations given in `q` (K 6 n values), or at `current` when `q`
+  /// is empty.
+  MassMatrixAnswer massMatrices(const SceneState& current, const std::vector<std::string>& names,
+                                const std::vector<double>& q, bool derivatives) const;
+
+  /// Positions (3 per vertex, fixed frame) and Jacobians (18 per vertex, 3x6
+  /// row-major) of the selected vertices (empty = all), at `q` (6 values) or
+  /// at the current state when `q` is empty. Outputs are resized here.
+  void vertexJacobians(const SceneState& current, const std::string& body, const std::vector<std::uint32_t>& vertices,
+                       const std::vector<double>& q, std::vector<double>& positions,
+                       std::vector<double>& jacobians) const;
+
+  /// dL/dq = sum_i J_i^T g_i for gradients g (3 per selected vertex).
+  Vector6<double> backprop(const SceneState& current, const std::string& body,
+                           const std::vector<std::uint32_t>& vertices, const std::vector<double>& gradients,
+                           const std::vector<double>& q) const;
+
+private:
+  /// The 6 values of q for body `index`: `q` if given, else the current state.
+  Vector6<double> stateOrCurrent(const SceneState& current, std::size_t index, const std::vector<double>& q) const;
+  /// Checks every index of `vertices` against body `index`.
+  std::size_t checkVertices(std::size_t index, const std::vector<std::uint32_t>& vertices) const;
+
+  Scene scene_;
+  std::vector<double> vertex_radius_;  ///< max_i |p0_i| per body [m]
+};
+
+/// Throws InvalidArgumentError("<field>[<i>]: not finite (...)") for the first
+/// non-finite value.
+void requireFinite(const double* values, std::size_t count, const std::string& field);
+
+}  // namespace diff_rigid_body

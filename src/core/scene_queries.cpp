@@ -1,0 +1,237 @@
+#include "diff_rigid_body/scene_queries.h"
+
+#include <cmath>
+#include <sstream>
+#include <unordered_set>
+
+#include "diff_rigid_body/exceptions.h"
+#include "diff_rigid_body/mass_matrix.h"
+
+namespace diff_rigid_body
+{
+namespace
+{
+[[noreturn]] void reject(const std::string& message)
+{
+  throw InvalidArgumentError(message);
+}
+
+std::string sizeMismatch(const std::string& field, const std::string& expected, std::size_t got)
+{
+  std::ostringstream why;
+  why << field << ": expected " << expected << ", got " << got << " values";
+  return why.str();
+}
+
+// Copies a 6x6 matrix row-major into `out`.
+void writeRowMajor(const Matrix6<double>& M, double* out)
+{
+  Eigen::Map<Eigen::Matrix<double, 6, 6, Eigen::RowMajor>> target(out);
+  target = M;
+}
+}  // namespace
+
+void requireFinite(const double* values, std::size_t count, const std::string& field)
+{
+  for (std::size_t i = 0; i < count; ++i)
+  {
+    if (!std::isfinite(values[i]))
+    {
+      std::ostringstream why;
+      why << field << "[" << i << "]: not finite (" << values[i] << ")";
+      reject(why.str());
+    }
+  }
+}
+
+SceneQueries::SceneQueries(Scene scene) : scene_(std::move(scene))
+{
+  for (const SceneBody& body : scene_.bodies)
+    vertex_radius_.push_back(body.body.vertices.cols() ? body.body.vertices.colwise().norm().maxCoeff() : 0.0);
+}
+
+SceneState SceneQueries::initialState() const
+{
+  SceneState state;
+  state.reserve(scene_.bodies.size());
+  for (const SceneBody& body : scene_.bodies)
+    state.push_back(body.initial_state);
+  return state;
+}
+
+std::size_t SceneQueries::bodyIndex(const std::string& name, const std::string& field) const
+{
+  const int index = scene_.findBody(name);
+  if (index >= 0)
+    return static_cast<std::size_t>(index);
+  std::string known;
+  for (const SceneBody& body : scene_.bodies)
+    known += (known.empty() ? "" : ", ") + body.body.name;
+  reject(field + ": unknown body '" + name + "' (bodies: " + known + ")");
+}
+
+std::vector<std::size_t> SceneQueries::bodyIndices(const std::vector<std::string>& names,
+                                                   const std::string& field) const
+{
+  if (names.size() > RequestLimits::kMaxStates)
+    reject(sizeMismatch(field, "at most " + std::to_string(RequestLimits::kMaxStates) + " names", names.size()));
+  std::vector<std::size_t> indices;
+  if (names.empty())
+  {
+    for (std::size_t i = 0; i < scene_.bodies.size(); ++i)
+      indices.push_back(i);
+    return indices;
+  }
+  indices.reserve(names.size());
+  for (std::size_t i = 0; i < names.size(); ++i)
+    indices.push_back(bodyIndex(names[i], field + "[" + std::to_string(i) + "]"));
+  return indices;
+}
+
+SceneState SceneQueries::applyStates(const SceneState& current, const std::vector<NamedState>& updates) const
+{
+  if (updates.size() > RequestLimits::kMaxStates)
+    reject(sizeMismatch("states", "at most " + std::to_string(RequestLimits::kMaxStates) + " states",
+                        updates.size()));
+  std::unordered_set<std::size_t> seen;
+  for (std::size_t i = 0; i < updates.size(); ++i)
+  {
+    const std::string field = "states[" + std::to_string(i) + "]";
+    const std::size_t index = bodyIndex(updates[i].name, field + ".name");
+    if (!seen.insert(index).second)
+      reject(field + ".name: body '" + updates[i].name + "' appears more than once");
+    requireFinite(updates[i].q.data(), 6, field + ".q (body '" + updates[i].name + "')");
+  }
+  SceneState next = current;
+  for (const NamedState& update : updates)
+    next[static_cast<std::size_t>(scene_.findBody(update.name))] = update.q;
+  return next;
+}
+
+std::vector<NamedState> SceneQueries::getStates(const SceneState& current, const std::vector<std::string>& names) const
+{
+  std::vector<NamedState> states;
+  for (std::size_t index : bodyIndices(names, "bodies"))
+    states.push_back({ scene_.bodies[index].body.name, current[index] });
+  return states;
+}
+
+MassMatrixAnswer SceneQueries::massMatrices(const SceneState& current, const std::vector<std::string>& names,
+                                            const std::vector<double>& q, bool derivatives) const
+{
+  const std::vector<std::size_t> indices = bodyIndices(names, "bodies");
+  const std::size_t n = indices.size();
+  std::size_t configurations = 1;
+  if (!q.empty())
+  {
+    if (n == 0 || q.size() % (6 * n) != 0)
+      reject(sizeMismatch("q", "a multiple of 6 x " + std::to_string(n) + " bodies (or empty for the current state)",
+                          q.size()));
+    configurations = q.size() / (6 * n);
+    requireFinite(q.data(), q.size(), "q");
+  }
+  const std::size_t matrices = configurations * n;
+  const std::size_t limit =
+      derivatives ? RequestLimits::kMaxMassMatricesWithDerivatives : RequestLimits::kMaxMassMatrices;
+  if (matrices > limit)
+    reject(sizeMismatch("q", "at most " + std::to_string(limit) + " matrices (configurations x bodies), i.e. " +
+                                 std::to_string(limit * 6) + " values",
+                        q.size()));
+
+  MassMatrixAnswer answer;
+  for (std::size_t index : indices)
+    answer.bodies.push_back(scene_.bodies[index].body.name);
+  answer.mass_matrices.resize(36 * matrices);
+  answer.cos_theta.resize(matrices);
+  if (derivatives)
+    answer.derivatives.resize(216 * matrices);
+  for (std::size_t k = 0; k < configurations; ++k)
+  {
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      const RigidBody& body = scene_.bodies[indices[i]].body;
+      const std::size_t slot = k * n + i;
+      const double phi = q.empty() ? current[indices[i]][PHI] : q[6 * slot + PHI];
+      const double theta = q.empty() ? current[indices[i]][THETA] : q[6 * slot + THETA];
+      const RpyTrig<double> trig(phi, theta, 0.0);
+      writeRowMajor(massMatrix(trig, body.mass, body.inertia_body), answer.mass_matrices.data() + 36 * slot);
+      answer.cos_theta[slot] = trig.c_theta;
+      if (derivatives)
+      {
+        const std::array<Matrix6<double>, 6> dM = massMatrixDerivatives(trig, body.inertia_body);
+        for (int j = 0; j < 6; ++j)
+          writeRowMajor(dM[j], answer.derivatives.data() + 216 * slot + 36 * j);
+      }
+    }
+  }
+  // Finite inputs can still overflow (e.g. an inertia near DBL_MAX): never
+  // return a non-finite number silently.
+  requireFinite(answer.mass_matrices.data(), answer.mass_matrices.size(), "result mass_matrices");
+  requireFinite(answer.derivatives.data(), answer.derivatives.size(), "result derivatives");
+  return answer;
+}
+
+Vector6<double> SceneQueries::stateOrCurrent(const SceneState& current, std::size_t index,
+                                             const std::vector<double>& q) const
+{
+  if (q.empty())
+    return current[index];
+  if (q.size() != 6)
+    reject(sizeMismatch("q", "6 values (or empty for the current state)", q.size()));
+  requireFinite(q.data(), 6, "q");
+  return Eigen::Map<const Vector6<double>>(q.data());
+}
+
+std::size_t SceneQueries::checkVertices(std::size_t index, const std::vector<std::uint32_t>& vertices) const
+{
+  const RigidBody& body = scene_.bodies[index].body;
+  const std::size_t available = static_cast<std::size_t>(body.vertices.cols());
+  const std::size_t count = vertices.empty() ? available : vertices.size();
+  if (count > RequestLimits::kMaxVertices)
+    reject(sizeMismatch("vertices", "at most " + std::to_string(RequestLimits::kMaxVertices) + " vertices", count));
+  for (std::size_t i = 0; i < vertices.size(); ++i)
+  {
+    if (vertices[i] >= available)
+    {
+      std::ostringstream why;
+      why << "vertices[" << i << "]: index " << vertices[i] << " out of range for body '" << body.name << "' with "
+          << available << " vertices";
+      reject(why.str());
+    }
+  }
+  return count;
+}
+
+void SceneQueries::vertexJacobians(const SceneState& current, const std::string& body_name,
+                                   const std::vector<std::uint32_t>& vertices, const std::vector<double>& q,
+                                   std::vector<double>& positions, std::vector<double>& jacobians) const
+{
+  const std::size_t index = bodyIndex(body_name, "body");
+  const std::size_t count = checkVertices(index, vertices);
+  const BodyPose<double> pose(stateOrCurrent(current, index, q));
+  // |p| <= |t|_inf + max_i |p0_i| bounds every output, so one check up front
+  // rules out overflow for all vertices.
+  if (!std::isfinite(pose.t.cwiseAbs().maxCoeff() + vertex_radius_[index]))
+    reject("q: position too large: vertex positions of body '" + body_name + "' would overflow");
+  positions.resize(3 * count);
+  jacobians.resize(18 * count);
+  vertexPositionsAndJacobians(pose, scene_.bodies[index].body.vertices, vertices, positions.data(), jacobians.data());
+}
+
+Vector6<double> SceneQueries::backprop(const SceneState& current, const std::string& body_name,
+                                       const std::vector<std::uint32_t>& vertices,
+                                       const std::vector<double>& gradients, const std::vector<double>& q) const
+{
+  const std::size_t index = bodyIndex(body_name, "body");
+  const std::size_t count = checkVertices(index, vertices);
+  if (gradients.size() != 3 * count)
+    reject(sizeMismatch("gradients", "3 per vertex = " + std::to_string(3 * count), gradients.size()));
+  requireFinite(gradients.data(), gradients.size(), "gradients");
+  const BodyPose<double> pose(stateOrCurrent(current, index, q));
+  const Vector6<double> gradient =
+      backpropagateVertexGradients(pose, scene_.bodies[index].body.vertices, vertices, gradients.data());
+  requireFinite(gradient.data(), 6, "result gradient (the gradients are too large)");
+  return gradient;
+}
+
+}  // namespace diff_rigid_body

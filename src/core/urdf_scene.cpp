@@ -1,0 +1,477 @@
+#include "diff_rigid_body/urdf_scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <unordered_map>
+
+#include <console_bridge/console.h>
+#include <tinyxml2.h>
+#include <urdf_parser/urdf_parser.h>
+
+#include "diff_rigid_body/exceptions.h"
+#include "diff_rigid_body/mass_properties.h"
+#include "diff_rigid_body/mesh_loader.h"
+
+namespace diff_rigid_body
+{
+namespace
+{
+// Collects urdfdom's console_bridge errors while it parses, so that they can
+// be quoted in the exception instead of only reaching stderr.
+class CapturedUrdfdomErrors : public console_bridge::OutputHandler
+{
+public:
+  CapturedUrdfdomErrors() { console_bridge::useOutputHandler(this); }
+  ~CapturedUrdfdomErrors() override { console_bridge::restorePreviousOutputHandler(); }
+  void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override
+  {
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR)
+      text_ += (text_.empty() ? "" : "; ") + text;
+  }
+  const std::string& text() const { return text_; }
+
+private:
+  std::string text_;
+};
+
+Eigen::Isometry3d toIsometry(const urdf::Pose& pose)
+{
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = Eigen::Quaterniond(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z)
+                   .normalized()
+                   .toRotationMatrix();
+  X.translation() << pose.position.x, pose.position.y, pose.position.z;
+  return X;
+}
+
+const char* jointTypeName(int type)
+{
+  switch (type)
+  {
+    case urdf::Joint::REVOLUTE:
+      return "revolute";
+    case urdf::Joint::CONTINUOUS:
+      return "continuous";
+    case urdf::Joint::PRISMATIC:
+      return "prismatic";
+    case urdf::Joint::FLOATING:
+      return "floating";
+    case urdf::Joint::PLANAR:
+      return "planar";
+    case urdf::Joint::FIXED:
+      return "fixed";
+    default:
+      return "unknown";
+  }
+}
+
+bool isFixed(const urdf::JointConstSharedPtr& joint)
+{
+  return joint && joint->type == urdf::Joint::FIXED;
+}
+
+// Link names in document order (urdfdom keeps them in a std::map).
+std::vector<std::string> linkNamesInDocumentOrder(const std::string& urdf_xml)
+{
+  tinyxml2::XMLDocument document;
+  if (document.Parse(urdf_xml.c_str(), urdf_xml.size()) != tinyxml2::XML_SUCCESS)
+  {
+    std::ostringstream why;
+    why << "robot description: malformed XML at line " << document.ErrorLineNum() << ": " << document.ErrorStr();
+    throw SceneDescriptionError(why.str());
+  }
+  const tinyxml2::XMLElement* robot = document.FirstChildElement("robot");
+  if (!robot)
+    throw SceneDescriptionError("robot description: no <robot> element");
+  std::vector<std::string> names;
+  for (const tinyxml2::XMLElement* link = robot->FirstChildElement("link"); link;
+       link = link->NextSiblingElement("link"))
+  {
+    const char* name = link->Attribute("name");
+    if (name)
+      names.emplace_back(name);
+  }
+  return names;
+}
+
+class SceneBuilder
+{
+public:
+  SceneBuilder(const std::string& urdf_xml, const SceneOptions& options) : options_(options)
+  {
+    document_order_ = linkNamesInDocumentOrder(urdf_xml);
+    {
+      CapturedUrdfdomErrors errors;
+      model_ = urdf::parseURDF(urdf_xml);
+      if (!model_)
+        throw SceneDescriptionError("robot description: urdfdom rejected it: " +
+                                    (errors.text().empty() ? std::string("(no reason given)") : errors.text()));
+    }
+    if (!model_->getRoot())
+      throw SceneDescriptionError("robot description: no root link");
+    if (options_.density && !(std::isfinite(*options_.density) && *options_.density > 0.0))
+    {
+      std::ostringstream why;
+      why << "parameter density: must be finite and > 0 kg/m^3, got " << *options_.density;
+      throw SceneDescriptionError(why.str());
+    }
+  }
+
+  Scene build()
+  {
+    Scene scene;
+    placeLinks(model_->getRoot(), Eigen::Isometry3d::Identity(), "");
+    const std::string root = model_->getRoot()->name;
+    scene.fixed_frame = options_.fixed_frame.empty() ? root : options_.fixed_frame;
+    const auto fixed = owner_.find(scene.fixed_frame);
+    if (fixed == owner_.end() || !fixed->second.empty())
+      throw SceneDescriptionError("parameter fixed_frame: '" + scene.fixed_frame + "' is not the root link '" + root +
+                                  "' or a link fixed to it");
+    const Eigen::Isometry3d fixed_from_root = pose_in_root_.at(scene.fixed_frame).inverse();
+
+    std::vector<std::string> body_links;
+    for (const std::string& name : document_order_)
+    {
+      if (owner_.at(name).empty())
+      {
+        if (name != scene.fixed_frame)
+          scene.static_links.push_back({ name, fixed_from_root * pose_in_root_.at(name) });
+      }
+      else if (owner_.at(name) == name)
+        body_links.push_back(name);
+    }
+    if (body_links.empty())
+      throw SceneDescriptionError("robot description: no body (no link is the child of a floating, revolute, "
+                                  "continuous, prismatic or planar joint)");
+
+    std::set<std::string> selected(options_.bodies.begin(), options_.bodies.end());
+    for (const std::string& name : options_.bodies)
+    {
+      if (std::find(body_links.begin(), body_links.end(), name) == body_links.end())
+      {
+        std::string known;
+        for (const auto& b : body_links)
+          known += (known.empty() ? "" : ", ") + b;
+        throw SceneDescriptionError("parameter bodies: unknown body '" + name + "' (bodies: " + known + ")");
+      }
+    }
+
+    for (const std::string& name : body_links)
+    {
+      if (!selected.empty() && !selected.count(name))
+        continue;
+      scene.bodies.push_back(buildBody(name, fixed_from_root));
+      const urdf::JointConstSharedPtr& joint = model_->getLink(name)->parent_joint;
+      if (joint->type != urdf::Joint::FLOATING)
+        scene.unmodelled_joints.push_back("joint '" + joint->name + "' (" + jointTypeName(joint->type) +
+                                          "): its constraint is not modelled; child '" + name +
+                                          "' is a free body posed at joint value 0");
+    }
+    return scene;
+  }
+
+private:
+  // Pose of every link in the root frame at zero joint values, and its owner:
+  // "" for a static link, else the body link it belongs to.
+  void placeLinks(const urdf::LinkConstSharedPtr& link, const Eigen::Isometry3d& pose, const std::string& owner)
+  {
+    pose_in_root_[link->name] = pose;
+    owner_[link->name] = owner;
+    for (const urdf::JointSharedPtr& joint : link->child_joints)
+    {
+      const urdf::LinkConstSharedPtr child = model_->getLink(joint->child_link_name);
+      const Eigen::Isometry3d child_pose = pose * toIsometry(joint->parent_to_joint_origin_transform);
+      if (!child_pose.matrix().allFinite())
+        throw SceneDescriptionError("joint '" + joint->name + "': <origin> is not finite");
+      placeLinks(child, child_pose, isFixed(joint) ? owner : child->name);
+    }
+  }
+
+  const TriangleMesh& meshFile(const urdf::Mesh& mesh, const std::string& link_name)
+  {
+    const std::string path = resolvePath(mesh.filename, link_name);
+    const Eigen::Vector3d scale(mesh.scale.x, mesh.scale.y, mesh.scale.z);
+    const auto key = std::make_pair(path, std::array<double, 3>{ scale.x(), scale.y(), scale.z() });
+    auto found = mesh_cache_.find(key);
+    if (found == mesh_cache_.end())
+    {
+      try
+      {
+        found = mesh_cache_.emplace(key, loadMeshFile(path, scale)).first;
+      }
+      catch (const MeshLoadError& e)
+      {
+        throw MeshLoadError("link '" + link_name + "': " + e.what());
+      }
+    }
+    return found->second;
+  }
+
+  std::string resolvePath(const std::string& uri, const std::string& link_name) const
+  {
+    const std::string package_scheme = "package://";
+    const std::string file_scheme = "file://";
+    if (uri.rfind(package_scheme, 0) == 0)
+    {
+      const std::string rest = uri.substr(package_scheme.size());
+      const std::size_t slash = rest.find('/');
+      const std::string package = rest.substr(0, slash);
+      std::string root;
+      if (options_.find_package)
+      {
+        try
+        {
+          root = options_.find_package(package);
+        }
+        catch (const std::exception&)
+        {
+          root.clear();
+        }
+      }
+      if (root.empty())
+        throw MeshLoadError("link '" + link_name + "': mesh '" + uri + "': cannot find package '" + package + "'");
+      return root + (slash == std::string::npos ? "" : rest.substr(slash));
+    }
+    if (uri.rfind(file_scheme, 0) == 0)
+      return uri.substr(file_scheme.size());
+    if (!uri.empty() && uri[0] == '/')
+      return uri;
+    if (!options_.base_directory.empty())
+      return options_.base_directory + "/" + uri;
+    throw MeshLoadError("link '" + link_name + "': mesh '" + uri +
+                        "': relative path with no base folder (use package://, file:// or an absolute path)");
+  }
+
+  // Geometry of one <collision> or <visual> element in its own frame.
+  TriangleMesh geometryMesh(const urdf::Geometry& geometry, const std::string& link_name)
+  {
+    // A primitive size must be finite and > 0 [m].
+    auto require_size = [&link_name](const char* what, double value) {
+      if (!(std::isfinite(value) && value > 0.0))
+      {
+        std::ostringstream why;
+        why << "link '" << link_name << "': " << what << " must be finite and > 0 m, got " << value;
+        throw SceneDescriptionError(why.str());
+      }
+    };
+    switch (geometry.type)
+    {
+      case urdf::Geometry::BOX:
+      {
+        const auto& box = static_cast<const urdf::Box&>(geometry);
+        require_size("box size x", box.dim.x);
+        require_size("box size y", box.dim.y);
+        require_size("box size z", box.dim.z);
+        return boxMesh(Eigen::Vector3d(box.dim.x, box.dim.y, box.dim.z));
+      }
+      case urdf::Geometry::SPHERE:
+        require_size("sphere radius", static_cast<const urdf::Sphere&>(geometry).radius);
+        return sphereMesh(static_cast<const urdf::Sphere&>(geometry).radius);
+      case urdf::Geometry::CYLINDER:
+      {
+        const auto& cylinder = static_cast<const urdf::Cylinder&>(geometry);
+        require_size("cylinder radius", cylinder.radius);
+        require_size("cylinder length", cylinder.length);
+        return cylinderMesh(cylinder.radius, cylinder.length);
+      }
+      case urdf::Geometry::MESH:
+        return meshFile(static_cast<const urdf::Mesh&>(geometry), link_name);
+    }
+    throw SceneDescriptionError("link '" + link_name + "': unknown geometry type");
+  }
+
+  // Mass properties of one geometry element in its own frame, for a density.
+  MassProperties geometryMassProperties(const urdf::Geometry& geometry, const TriangleMesh& mesh, double density,
+                                        const std::string& link_name)
+  {
+    try
+    {
+      switch (geometry.type)
+      {
+        case urdf::Geometry::BOX:
+        {
+          const auto& box = static_cast<const urdf::Box&>(geometry);
+          return boxMassProperties(density, Eigen::Vector3d(box.dim.x, box.dim.y, box.dim.z));
+        }
+        case urdf::Geometry::SPHERE:
+          return sphereMassProperties(density, static_cast<const urdf::Sphere&>(geometry).radius);
+        case urdf::Geometry::CYLINDER:
+        {
+          const auto& cylinder = static_cast<const urdf::Cylinder&>(geometry);
+          return cylinderMassProperties(density, cylinder.radius, cylinder.length);
+        }
+        default:
+          return meshMassProperties(density, mesh);
+      }
+    }
+    catch (const Error& e)
+    {
+      throw InvalidInertiaError("link '" + link_name + "': cannot compute inertia from its geometry: " + e.what());
+    }
+  }
+
+  SceneBody buildBody(const std::string& body_name, const Eigen::Isometry3d& fixed_from_root)
+  {
+    SceneBody scene_body;
+    scene_body.body.name = body_name;
+    const urdf::JointConstSharedPtr& joint = model_->getLink(body_name)->parent_joint;
+    scene_body.joint_name = joint->name;
+    scene_body.joint_type = jointTypeName(joint->type);
+
+    const Eigen::Isometry3d body_in_root = pose_in_root_.at(body_name);
+    std::vector<std::pair<Eigen::Isometry3d, MassProperties>> link_masses;
+    std::vector<std::pair<std::size_t, Eigen::Vector3d>> link_vertices;  // (link slot, position in body link frame)
+
+    std::vector<std::string> members{ body_name };
+    for (const std::string& name : document_order_)
+      if (name != body_name && owner_.at(name) == body_name)
+        members.push_back(name);
+
+    for (const std::string& name : members)
+    {
+      const urdf::LinkConstSharedPtr link = model_->getLink(name);
+      LinkInBody slot;
+      slot.name = name;
+      slot.pose_in_body_link = body_in_root.inverse() * pose_in_root_.at(name);
+
+      std::vector<std::pair<Eigen::Isometry3d, const urdf::Geometry*>> geometries = linkGeometries(*link);
+      std::vector<std::pair<Eigen::Isometry3d, MassProperties>> geometry_masses;
+      for (const auto& [origin, geometry] : geometries)
+      {
+        if (!origin.matrix().allFinite())
+          throw SceneDescriptionError("link '" + name + "': geometry <origin> is not finite");
+        const TriangleMesh mesh = geometryMesh(*geometry, name);
+        const Eigen::Isometry3d in_body_link = slot.pose_in_body_link * origin;
+        for (Eigen::Index v = 0; v < mesh.vertices.cols(); ++v)
+          link_vertices.emplace_back(scene_body.links.size(), in_body_link * mesh.vertices.col(v));
+        if (!link->inertial && options_.density)
+          geometry_masses.emplace_back(origin, geometryMassProperties(*geometry, mesh, *options_.density, name));
+      }
+
+      if (link->inertial)
+      {
+        const urdf::Inertial& inertial = *link->inertial;
+        const Eigen::Isometry3d frame = toIsometry(inertial.origin);
+        if (!frame.matrix().allFinite())
+          throw InvalidInertiaError("link '" + name + "' <inertial>: <origin> is not finite");
+        Eigen::Matrix3d inertia;
+        inertia << inertial.ixx, inertial.ixy, inertial.ixz,  //
+            inertial.ixy, inertial.iyy, inertial.iyz,         //
+            inertial.ixz, inertial.iyz, inertial.izz;
+        validateMassProperties("link '" + name + "' <inertial>", inertial.mass, inertia);
+        MassProperties properties;
+        properties.mass = inertial.mass;
+        properties.com = frame.translation();
+        properties.inertia = frame.linear() * inertia * frame.linear().transpose();  // I_link = R_o I R_o^T
+        link_masses.emplace_back(slot.pose_in_body_link, properties);
+      }
+      else if (!geometry_masses.empty())
+      {
+        link_masses.emplace_back(slot.pose_in_body_link, combineMassProperties(geometry_masses));
+      }
+      scene_body.links.push_back(std::move(slot));
+    }
+
+    if (link_masses.empty())
+      throw InvalidInertiaError("body '" + body_name + "': no <inertial> in its link or merged links" +
+                                (options_.density ? std::string(" and no geometry to compute one from") :
+                                                    std::string(", and parameter density is not set")));
+    const MassProperties composite = combineMassProperties(link_masses);
+    validateMassProperties("body '" + body_name + "'", composite.mass, composite.inertia);
+    scene_body.body.mass = composite.mass;
+    scene_body.body.com_offset = composite.com;
+    scene_body.body.inertia_body = composite.inertia;
+
+    // Unique positions in the body frame (origin at the COM), first occurrence order.
+    std::map<std::array<double, 3>, std::uint32_t> index_of;
+    std::vector<Eigen::Vector3d> unique;
+    for (const auto& [slot, position] : link_vertices)
+    {
+      const Eigen::Vector3d p = position - composite.com;
+      const std::array<double, 3> key{ p.x() + 0.0, p.y() + 0.0, p.z() + 0.0 };  // + 0.0 folds -0 into +0
+      const auto inserted = index_of.emplace(key, static_cast<std::uint32_t>(unique.size()));
+      if (inserted.second)
+        unique.push_back(p);
+      scene_body.links[slot].vertex_indices.push_back(inserted.first->second);
+    }
+    scene_body.body.vertices.resize(3, static_cast<Eigen::Index>(unique.size()));
+    for (std::size_t i = 0; i < unique.size(); ++i)
+      scene_body.body.vertices.col(static_cast<Eigen::Index>(i)) = unique[i];
+
+    if (!scene_body.body.vertices.allFinite())
+      throw SceneDescriptionError("body '" + body_name + "': vertex coordinates overflow (check mesh scales)");
+
+    // Initial state: link axes' RPY and COM position, in the fixed frame.
+    const Eigen::Isometry3d body_in_fixed = fixed_from_root * body_in_root;
+    scene_body.initial_state.head<3>() = matrixToRpy(body_in_fixed.linear());
+    scene_body.initial_state.tail<3>() = body_in_fixed * composite.com;
+    return scene_body;
+  }
+
+  // The link's chosen geometry elements (collision or visual, falling back to
+  // the other kind), each with its origin in the link frame.
+  std::vector<std::pair<Eigen::Isometry3d, const urdf::Geometry*>> linkGeometries(const urdf::Link& link) const
+  {
+    std::vector<std::pair<Eigen::Isometry3d, const urdf::Geometry*>> collisions, visuals;
+    for (const auto& c : link.collision_array)
+      if (c && c->geometry)
+        collisions.emplace_back(toIsometry(c->origin), c->geometry.get());
+    for (const auto& v : link.visual_array)
+      if (v && v->geometry)
+        visuals.emplace_back(toIsometry(v->origin), v->geometry.get());
+    if (options_.geometry == GeometrySource::Collision)
+      return collisions.empty() ? visuals : collisions;
+    return visuals.empty() ? collisions : visuals;
+  }
+
+  const SceneOptions& options_;
+  urdf::ModelInterfaceSharedPtr model_;
+  std::vector<std::string> document_order_;
+  std::unordered_map<std::string, Eigen::Isometry3d> pose_in_root_;
+  std::unordered_map<std::string, std::string> owner_;
+  std::map<std::pair<std::string, std::array<double, 3>>, TriangleMesh> mesh_cache_;
+};
+
+}  // namespace
+
+int Scene::findBody(const std::string& name) const
+{
+  for (std::size_t i = 0; i < bodies.size(); ++i)
+    if (bodies[i].body.name == name)
+      return static_cast<int>(i);
+  return -1;
+}
+
+Scene loadSceneFromUrdf(const std::string& urdf_xml, const SceneOptions& options)
+{
+  return SceneBuilder(urdf_xml, options).build();
+}
+
+Scene loadSceneFromUrdfFile(const std::string& path, SceneOptions options)
+{
+  std::ifstream file(path);
+  if (!file)
+    throw SceneDescriptionError("URDF file '" + path + "': cannot be opened");
+  std::stringstream text;
+  text << file.rdbuf();
+  if (options.base_directory.empty())
+  {
+    const std::size_t slash = path.find_last_of('/');
+    options.base_directory = slash == std::string::npos ? "." : path.substr(0, slash);
+  }
+  return loadSceneFromUrdf(text.str(), options);
+}
+
+Eigen::Isometry3d linkPoseFromState(const Vector6<double>& q, const Eigen::Vector3d& com_offset)
+{
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = rpyToMatrix(RpyTrig<double>(q));
+  pose.translation() = q.tail<3>() - pose.linear() * com_offset;
+  return pose;
+}
+
+}  // namespace diff_rigid_body

@@ -1,0 +1,228 @@
+#include "rigid_body_server.h"
+
+#include <algorithm>
+
+#include <geometry_msgs/TransformStamped.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include "diff_rigid_body/exceptions.h"
+
+namespace diff_rigid_body
+{
+namespace
+{
+geometry_msgs::TransformStamped toTransform(const Eigen::Isometry3d& pose, const std::string& parent,
+                                            const std::string& child, const ros::Time& stamp)
+{
+  geometry_msgs::TransformStamped transform;
+  transform.header.stamp = stamp;
+  transform.header.frame_id = parent;
+  transform.child_frame_id = child;
+  transform.transform.translation.x = pose.translation().x();
+  transform.transform.translation.y = pose.translation().y();
+  transform.transform.translation.z = pose.translation().z();
+  const Eigen::Quaterniond rotation(pose.linear());
+  transform.transform.rotation.x = rotation.x();
+  transform.transform.rotation.y = rotation.y();
+  transform.transform.rotation.z = rotation.z();
+  transform.transform.rotation.w = rotation.w();
+  return transform;
+}
+
+// Runs `work`; a core error becomes success=false with its message, so that
+// the client receives it and nothing else happens. Returns true for roscpp.
+template <typename Response, typename Work>
+bool serve(Response& response, const char* service, Work&& work)
+{
+  try
+  {
+    work();
+    response.success = true;
+    response.message = "";
+  }
+  catch (const Error& e)
+  {
+    response = Response();
+    response.success = false;
+    response.message = e.what();
+    ROS_DEBUG_STREAM(service << ": refused: " << e.what());
+  }
+  catch (const std::exception& e)  // e.g. std::bad_alloc: report, keep serving
+  {
+    response = Response();
+    response.success = false;
+    response.message = std::string("internal error: ") + e.what();
+    ROS_ERROR_STREAM(service << ": " << response.message);
+  }
+  return true;
+}
+
+std::vector<NamedState> toNamedStates(const std::vector<BodyState>& states)
+{
+  std::vector<NamedState> named;
+  named.reserve(states.size());
+  for (const BodyState& state : states)
+    named.push_back({ state.name, Eigen::Map<const Vector6<double>>(state.q.data()) });
+  return named;
+}
+}  // namespace
+
+RigidBodyServer::RigidBodyServer(ros::NodeHandle& nh, ros::NodeHandle& private_nh, Scene scene,
+                                 const ServerSettings& settings)
+  : queries_(std::move(scene)), state_(std::make_shared<const SceneState>(queries_.initialState()))
+{
+  (void)nh;
+  states_publisher_ = private_nh.advertise<BodyStateArray>("states", 10, /*latch=*/true);
+  publishStaticLinks();
+  publishState(*state_, ros::Time::now());
+
+  services_.push_back(private_nh.advertiseService("get_bodies", &RigidBodyServer::getBodies, this));
+  services_.push_back(private_nh.advertiseService("set_state", &RigidBodyServer::setState, this));
+  services_.push_back(private_nh.advertiseService("get_state", &RigidBodyServer::getState, this));
+  services_.push_back(private_nh.advertiseService("get_mass_matrix", &RigidBodyServer::getMassMatrix, this));
+  services_.push_back(
+      private_nh.advertiseService("get_vertex_jacobians", &RigidBodyServer::getVertexJacobians, this));
+  services_.push_back(private_nh.advertiseService("backprop", &RigidBodyServer::backprop, this));
+  set_states_subscriber_ = private_nh.subscribe("set_states", 100, &RigidBodyServer::onSetStates, this,
+                                                ros::TransportHints().tcpNoDelay());
+  timer_ = private_nh.createTimer(ros::Duration(1.0 / settings.publish_rate), &RigidBodyServer::onTimer, this);
+}
+
+RigidBodyServer::StatePtr RigidBodyServer::snapshot() const
+{
+  std::lock_guard<std::mutex> lock(snapshot_mutex_);
+  return state_;
+}
+
+void RigidBodyServer::applyStates(const std::vector<BodyState>& states)
+{
+  std::lock_guard<std::mutex> write(write_mutex_);
+  auto next = std::make_shared<const SceneState>(queries_.applyStates(*snapshot(), toNamedStates(states)));
+  {
+    std::lock_guard<std::mutex> lock(snapshot_mutex_);
+    state_ = next;
+  }
+  publishState(*next, ros::Time::now());
+}
+
+void RigidBodyServer::publishState(const SceneState& state, const ros::Time& stamp)
+{
+  const Scene& scene = queries_.scene();
+  std::vector<geometry_msgs::TransformStamped> transforms;
+  BodyStateArray states;
+  states.header.stamp = stamp;
+  states.header.frame_id = scene.fixed_frame;
+  for (std::size_t i = 0; i < scene.bodies.size(); ++i)
+  {
+    const SceneBody& body = scene.bodies[i];
+    const Eigen::Isometry3d link_pose = linkPoseFromState(state[i], body.body.com_offset);
+    for (const LinkInBody& link : body.links)
+      transforms.push_back(toTransform(link_pose * link.pose_in_body_link, scene.fixed_frame, link.name, stamp));
+    BodyState body_state;
+    body_state.name = body.body.name;
+    std::copy(state[i].data(), state[i].data() + 6, body_state.q.begin());
+    states.states.push_back(std::move(body_state));
+  }
+  tf_broadcaster_.sendTransform(transforms);  // one TFMessage for all frames
+  states_publisher_.publish(states);
+}
+
+void RigidBodyServer::publishStaticLinks()
+{
+  const Scene& scene = queries_.scene();
+  if (scene.static_links.empty())
+    return;
+  std::vector<geometry_msgs::TransformStamped> transforms;
+  const ros::Time stamp = ros::Time::now();
+  for (const StaticLink& link : scene.static_links)
+    transforms.push_back(toTransform(link.pose_in_fixed_frame, scene.fixed_frame, link.name, stamp));
+  static_broadcaster_.sendTransform(transforms);
+}
+
+bool RigidBodyServer::getBodies(GetBodies::Request&, GetBodies::Response& response)
+{
+  return serve(response, "get_bodies", [&] {
+    response.fixed_frame = queries_.scene().fixed_frame;
+    for (std::size_t i = 0; i < queries_.bodyCount(); ++i)
+    {
+      const RigidBody& body = queries_.body(i);
+      response.names.push_back(body.name);
+      response.masses.push_back(body.mass);
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c)
+          response.inertias.push_back(body.inertia_body(r, c));
+      for (int k = 0; k < 3; ++k)
+        response.com_offsets.push_back(body.com_offset[k]);
+      response.vertex_counts.push_back(static_cast<std::uint32_t>(body.vertices.cols()));
+    }
+  });
+}
+
+bool RigidBodyServer::setState(SetState::Request& request, SetState::Response& response)
+{
+  return serve(response, "set_state", [&] { applyStates(request.states); });
+}
+
+bool RigidBodyServer::getState(GetState::Request& request, GetState::Response& response)
+{
+  return serve(response, "get_state", [&] {
+    for (const NamedState& named : queries_.getStates(*snapshot(), request.bodies))
+    {
+      BodyState state;
+      state.name = named.name;
+      std::copy(named.q.data(), named.q.data() + 6, state.q.begin());
+      response.states.push_back(std::move(state));
+    }
+  });
+}
+
+bool RigidBodyServer::getMassMatrix(GetMassMatrix::Request& request, GetMassMatrix::Response& response)
+{
+  return serve(response, "get_mass_matrix", [&] {
+    MassMatrixAnswer answer = queries_.massMatrices(*snapshot(), request.bodies, request.q, request.derivatives);
+    response.bodies = std::move(answer.bodies);
+    response.mass_matrices = std::move(answer.mass_matrices);
+    response.derivatives = std::move(answer.derivatives);
+    response.cos_theta = std::move(answer.cos_theta);
+  });
+}
+
+bool RigidBodyServer::getVertexJacobians(GetVertexJacobians::Request& request,
+                                         GetVertexJacobians::Response& response)
+{
+  return serve(response, "get_vertex_jacobians", [&] {
+    queries_.vertexJacobians(*snapshot(), request.body, request.vertices, request.q, response.positions,
+                             response.jacobians);
+  });
+}
+
+bool RigidBodyServer::backprop(Backprop::Request& request, Backprop::Response& response)
+{
+  return serve(response, "backprop", [&] {
+    const Vector6<double> gradient =
+        queries_.backprop(*snapshot(), request.body, request.vertices, request.gradients, request.q);
+    std::copy(gradient.data(), gradient.data() + 6, response.gradient.begin());
+  });
+}
+
+void RigidBodyServer::onSetStates(const BodyStateArray::ConstPtr& message)
+{
+  try
+  {
+    applyStates(message->states);
+  }
+  catch (const Error& e)
+  {
+    ROS_WARN_STREAM_THROTTLE(1.0, "set_states: message dropped: " << e.what());
+  }
+}
+
+void RigidBodyServer::onTimer(const ros::TimerEvent&)
+{
+  // Under the write lock, so a periodic message never goes out after (and
+  // overrides) a newer state published by a writer.
+  std::lock_guard<std::mutex> write(write_mutex_);
+  publishState(*snapshot(), ros::Time::now());
+}
+
+}  // namespace diff_rigid_body

@@ -1,0 +1,76 @@
+// rigid_body_server: the ROS layer over the core library.
+//
+// Messages in, core calls (SceneQueries), messages out. Core exceptions are
+// caught at this boundary and become `success=false, message=...`; the
+// callbacks always return true so that clients receive the message.
+//
+// Concurrency: the state is an immutable snapshot behind a shared_ptr.
+// Readers take the current pointer under a short lock and compute without
+// locks, so every answer comes from one consistent state; writers are
+// serialised by a second mutex and swap in a new snapshot.
+#pragma once
+
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include <ros/ros.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+#include <tf2_ros/transform_broadcaster.h>
+
+#include <diff_rigid_body/Backprop.h>
+#include <diff_rigid_body/BodyStateArray.h>
+#include <diff_rigid_body/GetBodies.h>
+#include <diff_rigid_body/GetMassMatrix.h>
+#include <diff_rigid_body/GetState.h>
+#include <diff_rigid_body/GetVertexJacobians.h>
+#include <diff_rigid_body/SetState.h>
+
+#include "diff_rigid_body/scene_queries.h"
+
+namespace diff_rigid_body
+{
+/// Node settings, read once from the private namespace.
+struct ServerSettings
+{
+  double publish_rate = 50.0;  ///< [Hz] tf and ~states, clamped to [0.1, 1000]
+};
+
+class RigidBodyServer
+{
+public:
+  /// Takes a loaded scene and starts serving on `private_nh`.
+  RigidBodyServer(ros::NodeHandle& nh, ros::NodeHandle& private_nh, Scene scene, const ServerSettings& settings);
+
+private:
+  using StatePtr = std::shared_ptr<const SceneState>;
+
+  StatePtr snapshot() const;
+  /// Validates and applies named states (all or nothing), then publishes them.
+  void applyStates(const std::vector<BodyState>& states);
+  void publishState(const SceneState& state, const ros::Time& stamp);
+  void publishStaticLinks();
+
+  bool getBodies(GetBodies::Request& request, GetBodies::Response& response);
+  bool setState(SetState::Request& request, SetState::Response& response);
+  bool getState(GetState::Request& request, GetState::Response& response);
+  bool getMassMatrix(GetMassMatrix::Request& request, GetMassMatrix::Response& response);
+  bool getVertexJacobians(GetVertexJacobians::Request& request, GetVertexJacobians::Response& response);
+  bool backprop(Backprop::Request& request, Backprop::Response& response);
+  void onSetStates(const BodyStateArray::ConstPtr& message);
+  void onTimer(const ros::TimerEvent& event);
+
+  const SceneQueries queries_;
+  mutable std::mutex snapshot_mutex_;  ///< guards state_ (the pointer, not the data)
+  std::mutex write_mutex_;             ///< serialises state changes and their publication
+  StatePtr state_;
+
+  tf2_ros::TransformBroadcaster tf_broadcaster_;
+  tf2_ros::StaticTransformBroadcaster static_broadcaster_;
+  ros::Publisher states_publisher_;
+  ros::Subscriber set_states_subscriber_;
+  std::vector<ros::ServiceServer> services_;
+  ros::Timer timer_;
+};
+
+}  // namespace diff_rigid_body

@@ -1,0 +1,107 @@
+// rigid_body_server: loads a URDF scene and serves differentiable rigid-body
+// quantities. An unusable description is logged and the node exits with 1;
+// it never half-starts.
+#include <cmath>
+#include <sstream>
+
+#include <ros/package.h>
+#include <ros/ros.h>
+
+#include "diff_rigid_body/exceptions.h"
+#include "rigid_body_server.h"
+
+namespace drb = diff_rigid_body;
+
+namespace
+{
+// Reads ~bodies as a list of strings, or as one string of names separated by
+// commas or spaces (convenient on the roslaunch command line).
+std::vector<std::string> readBodies(const ros::NodeHandle& private_nh)
+{
+  std::vector<std::string> bodies;
+  if (private_nh.getParam("bodies", bodies))
+    return bodies;
+  std::string text;
+  if (private_nh.getParam("bodies", text))
+  {
+    std::replace(text.begin(), text.end(), ',', ' ');
+    std::istringstream words(text);
+    for (std::string word; words >> word;)
+      bodies.push_back(word);
+    return bodies;
+  }
+  if (private_nh.hasParam("bodies"))
+    throw drb::SceneDescriptionError("parameter ~bodies: must be a list of body names");
+  return bodies;
+}
+
+drb::SceneOptions readSceneOptions(const ros::NodeHandle& private_nh)
+{
+  drb::SceneOptions options;
+  const std::string geometry = private_nh.param<std::string>("geometry", "collision");
+  if (geometry == "visual")
+    options.geometry = drb::GeometrySource::Visual;
+  else if (geometry != "collision")
+    throw drb::SceneDescriptionError("parameter ~geometry: must be 'collision' or 'visual', got '" + geometry + "'");
+  double density = 0.0;
+  if (private_nh.getParam("density", density))
+    options.density = density;
+  else if (private_nh.hasParam("density"))
+    throw drb::SceneDescriptionError("parameter ~density: must be a number [kg/m^3]");
+  options.bodies = readBodies(private_nh);
+  options.fixed_frame = private_nh.param<std::string>("fixed_frame", "");
+  options.find_package = [](const std::string& package) { return ros::package::getPath(package); };
+  return options;
+}
+
+drb::Scene loadScene(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh)
+{
+  const drb::SceneOptions options = readSceneOptions(private_nh);
+  const std::string urdf_path = private_nh.param<std::string>("urdf_path", "");
+  if (!urdf_path.empty())
+    return drb::loadSceneFromUrdfFile(urdf_path, options);
+  std::string urdf_xml;
+  if (!nh.getParam("robot_description", urdf_xml))
+    throw drb::SceneDescriptionError("no robot description: set the parameter '" +
+                                     nh.resolveName("robot_description") + "' or ~urdf_path");
+  return drb::loadSceneFromUrdf(urdf_xml, options);
+}
+}  // namespace
+
+int main(int argc, char** argv)
+{
+  ros::init(argc, argv, "rigid_body_server");
+  ros::NodeHandle nh;
+  ros::NodeHandle private_nh("~");
+
+  drb::ServerSettings settings;
+  const double rate = private_nh.param("publish_rate", settings.publish_rate);
+  settings.publish_rate = std::isfinite(rate) ? std::clamp(rate, 0.1, 1000.0) : settings.publish_rate;
+  if (settings.publish_rate != rate)
+    ROS_WARN("~publish_rate %g Hz is out of range; using %g Hz", rate, settings.publish_rate);
+  const int threads = std::clamp(private_nh.param("threads", 4), 1, 64);
+
+  drb::Scene scene;
+  try
+  {
+    scene = loadScene(nh, private_nh);
+  }
+  catch (const drb::Error& e)
+  {
+    ROS_FATAL_STREAM("rigid_body_server: cannot load the scene: " << e.what());
+    return 1;
+  }
+  for (const std::string& joint : scene.unmodelled_joints)
+    ROS_INFO_STREAM("rigid_body_server: " << joint);
+
+  std::ostringstream summary;
+  for (const drb::SceneBody& body : scene.bodies)
+    summary << " " << body.body.name << " (" << body.body.vertices.cols() << " vertices)";
+  ROS_INFO_STREAM("rigid_body_server: serving " << scene.bodies.size() << " bodies in '" << scene.fixed_frame
+                                                << "':" << summary.str());
+
+  drb::RigidBodyServer server(nh, private_nh, std::move(scene), settings);
+  ros::MultiThreadedSpinner spinner(static_cast<std::uint32_t>(threads));
+  spinner.spin();
+  return 0;
+}

@@ -1,0 +1,417 @@
+// Shared test oracles for the kinematics kernels (rpy.h, mass_matrix.h,
+// vertex_jacobian.h).
+//
+// Everything here is written from /work/shared/design/math.md, NOT from the
+// headers under test: rotations are products of elementary rotations, dR is
+// the long form (Rz Ry Rx' etc.), T is assembled from the definition of the
+// rotation axes, M is T^T R I_b R^T T. The kernels use the closed-form entries,
+// cross products, A = R^T T and A^T I_b A instead, so an agreement between the
+// two is evidence, not a tautology.
+//
+// Also here: fixed-seed random states, the hard-case list of math.md, a
+// complex-step helper and error metrics (max-abs, ulp).
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cfloat>
+#include <cmath>
+#include <complex>
+#include <cstdint>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include <Eigen/Core>
+#include <mpreal.h>
+
+#include "diff_rigid_body/rpy.h"
+
+namespace drb_test
+{
+using diff_rigid_body::Matrix3;
+using diff_rigid_body::Matrix36;
+using diff_rigid_body::Matrix6;
+using diff_rigid_body::Vector3;
+using diff_rigid_body::Vector6;
+using Complex = std::complex<double>;
+
+constexpr double kEps = std::numeric_limits<double>::epsilon();  // 2^-52
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kHalfPi = kPi / 2;  // == M_PI_2, the double nearest pi/2
+
+// ---------------------------------------------------------------------------
+// Elementary rotations and their derivatives (right-handed, active).
+
+template <typename S>
+Matrix3<S> rotX(const S& a)
+{
+  using std::cos;
+  using std::sin;
+  const S c = cos(a), s = sin(a);
+  Matrix3<S> m;
+  m << S(1), S(0), S(0),  //
+      S(0), c, -s,        //
+      S(0), s, c;
+  return m;
+}
+
+template <typename S>
+Matrix3<S> rotY(const S& a)
+{
+  using std::cos;
+  using std::sin;
+  const S c = cos(a), s = sin(a);
+  Matrix3<S> m;
+  m << c, S(0), s,     //
+      S(0), S(1), S(0),  //
+      -s, S(0), c;
+  return m;
+}
+
+template <typename S>
+Matrix3<S> rotZ(const S& a)
+{
+  using std::cos;
+  using std::sin;
+  const S c = cos(a), s = sin(a);
+  Matrix3<S> m;
+  m << c, -s, S(0),  //
+      s, c, S(0),    //
+      S(0), S(0), S(1);
+  return m;
+}
+
+// d/da of the elementary rotations (entry-wise derivative).
+template <typename S>
+Matrix3<S> rotXPrime(const S& a)
+{
+  using std::cos;
+  using std::sin;
+  const S c = cos(a), s = sin(a);
+  Matrix3<S> m;
+  m << S(0), S(0), S(0),  //
+      S(0), -s, -c,       //
+      S(0), c, -s;
+  return m;
+}
+
+template <typename S>
+Matrix3<S> rotYPrime(const S& a)
+{
+  using std::cos;
+  using std::sin;
+  const S c = cos(a), s = sin(a);
+  Matrix3<S> m;
+  m << -s, S(0), c,        //
+      S(0), S(0), S(0),  //
+      -c, S(0), -s;
+  return m;
+}
+
+template <typename S>
+Matrix3<S> rotZPrime(const S& a)
+{
+  using std::cos;
+  using std::sin;
+  const S c = cos(a), s = sin(a);
+  Matrix3<S> m;
+  m << -s, -c, S(0),  //
+      c, -s, S(0),    //
+      S(0), S(0), S(0);
+  return m;
+}
+
+// ---------------------------------------------------------------------------
+// Reference kinematics (math.md), q = (phi, theta, psi, tx, ty, tz).
+
+/// R = Rz(psi) Ry(theta) Rx(phi), as a product of elementary rotations.
+template <typename S>
+Matrix3<S> refRotation(const S& phi, const S& theta, const S& psi)
+{
+  return rotZ(psi) * rotY(theta) * rotX(phi);
+}
+
+/// Long form: dR/dphi = Rz Ry Rx', dR/dtheta = Rz Ry' Rx, dR/dpsi = Rz' Ry Rx.
+template <typename S>
+std::array<Matrix3<S>, 3> refRotationDerivatives(const S& phi, const S& theta, const S& psi)
+{
+  return { rotZ(psi) * rotY(theta) * rotXPrime(phi), rotZ(psi) * rotYPrime(theta) * rotX(phi),
+           rotZPrime(psi) * rotY(theta) * rotX(phi) };
+}
+
+/// T from the axis definition: omega = phidot e_X'' + thetadot e_Y' + psidot e_Z.
+/// In world coordinates e_Z = (0,0,1), e_Y' = Rz(psi) e_y and
+/// e_X'' = Rz(psi) Ry(theta) e_x (Rx(phi) leaves e_x fixed).
+template <typename S>
+Matrix3<S> refAngularVelocityMatrix(const S& phi, const S& theta, const S& psi)
+{
+  (void)phi;
+  const Vector3<S> ex(S(1), S(0), S(0)), ey(S(0), S(1), S(0)), ez(S(0), S(0), S(1));
+  Matrix3<S> T;
+  T.col(0) = rotZ(psi) * (rotY(theta) * ex);
+  T.col(1) = rotZ(psi) * ey;
+  T.col(2) = ez;
+  return T;
+}
+
+/// [v]_x, the cross-product matrix.
+template <typename S>
+Matrix3<S> skew(const Vector3<S>& v)
+{
+  Matrix3<S> m;
+  m << S(0), -v[2], v[1],  //
+      v[2], S(0), -v[0],   //
+      -v[1], v[0], S(0);
+  return m;
+}
+
+/// Inverse of skew, taking the antisymmetric part.
+template <typename S>
+Vector3<S> vee(const Matrix3<S>& m)
+{
+  return Vector3<S>((m(2, 1) - m(1, 2)) / S(2), (m(0, 2) - m(2, 0)) / S(2), (m(1, 0) - m(0, 1)) / S(2));
+}
+
+/// J = [dR/dphi p0, dR/dtheta p0, dR/dpsi p0 | I3], long form.
+template <typename S>
+Matrix36<S> refJacobian(const Vector6<S>& q, const Vector3<S>& p0)
+{
+  const auto dR = refRotationDerivatives(q[0], q[1], q[2]);
+  Matrix36<S> J = Matrix36<S>::Zero();
+  for (int k = 0; k < 3; ++k)
+    J.col(k) = dR[k] * p0;
+  J.template rightCols<3>().setIdentity();
+  return J;
+}
+
+/// p = R p0 + t with the product-form R.
+template <typename S>
+Vector3<S> refPosition(const Vector6<S>& q, const Vector3<S>& p0)
+{
+  return refRotation(q[0], q[1], q[2]) * p0 + q.template tail<3>();
+}
+
+/// M = blockdiag(T^T I' T, m I3), I' = R I_b R^T: the world-frame form of
+/// the seed's eq. (21) with the corrected (m I3) lower block.
+template <typename S>
+Matrix6<S> refMassMatrix(const Vector6<S>& q, const S& mass, const Matrix3<S>& inertia_body)
+{
+  const Matrix3<S> R = refRotation(q[0], q[1], q[2]);
+  const Matrix3<S> T = refAngularVelocityMatrix(q[0], q[1], q[2]);
+  const Matrix3<S> I_world = R * inertia_body * R.transpose();
+  Matrix6<S> M = Matrix6<S>::Zero();
+  M.template topLeftCorner<3, 3>() = T.transpose() * I_world * T;
+  for (int i = 3; i < 6; ++i)
+    M(i, i) = mass;
+  return M;
+}
+
+/// Inertia about the origin of point masses, seed eq. (17):
+/// I = sum m_i (p_i^T p_i I3 - p_i p_i^T).
+template <typename S>
+Matrix3<S> particleInertia(const std::vector<Vector3<S>>& points, const std::vector<S>& masses)
+{
+  Matrix3<S> I = Matrix3<S>::Zero();
+  for (std::size_t i = 0; i < points.size(); ++i)
+    I += masses[i] * (points[i].squaredNorm() * Matrix3<S>::Identity() - points[i] * points[i].transpose());
+  return I;
+}
+
+// ---------------------------------------------------------------------------
+// Complex step.
+
+/// The complex-step increment. Im(f(x + i h))/h = f'(x) + O(h^2) with no
+/// subtractive cancellation, so h can be tiny; 1e-30 makes the O(h^2) term
+/// vanish (1e-60 relative) without any underflow for our magnitudes.
+constexpr double kComplexStepH = 1e-30;
+
+inline Vector6<Complex> complexPerturbed(const Vector6<double>& q, int j)
+{
+  Vector6<Complex> qc = q.cast<Complex>();
+  qc[j] += Complex(0.0, kComplexStepH);
+  return qc;
+}
+
+/// d f / d q_j by the complex step; f maps Vector6<Complex> to any complex
+/// Eigen matrix or a scalar.
+template <typename F>
+auto complexStep(const F& f, const Vector6<double>& q, int j)
+{
+  const auto value = f(complexPerturbed(q, j));
+  return Eigen::MatrixXd(value.imag() / kComplexStepH);
+}
+
+// ---------------------------------------------------------------------------
+// Fixed-seed random inputs.
+
+/// Deterministic generator. Every test constructs its own with a fixed seed.
+class Random
+{
+public:
+  explicit Random(std::uint64_t seed) : engine_(seed)
+  {
+  }
+
+  double uniform(double lo, double hi)
+  {
+    return std::uniform_real_distribution<double>(lo, hi)(engine_);
+  }
+
+  /// log-uniform on [lo, hi], lo > 0.
+  double logUniform(double lo, double hi)
+  {
+    return std::exp(uniform(std::log(lo), std::log(hi)));
+  }
+
+  int integer(int lo, int hi)
+  {
+    return std::uniform_int_distribution<int>(lo, hi)(engine_);
+  }
+
+  /// Angles uniform in (-pi, pi] for all three (theta beyond +-pi/2 is a valid
+  /// state too), translation in [-10, 10]^3 m.
+  Vector6<double> state()
+  {
+    Vector6<double> q;
+    for (int i = 0; i < 3; ++i)
+      q[i] = uniform(-kPi, kPi);
+    for (int i = 3; i < 6; ++i)
+      q[i] = uniform(-10.0, 10.0);
+    return q;
+  }
+
+  Vector3<double> vector(double scale)
+  {
+    return Vector3<double>(uniform(-scale, scale), uniform(-scale, scale), uniform(-scale, scale));
+  }
+
+  /// A vertex of norm `scale`, random direction.
+  Vector3<double> vertexOfNorm(double scale)
+  {
+    Vector3<double> v;
+    do
+      v = vector(1.0);
+    while (v.norm() < 0.1 || v.norm() > 1.0);
+    return v.normalized() * scale;
+  }
+
+  Matrix3<double> rotation()
+  {
+    return refRotation(uniform(-kPi, kPi), uniform(-kPi, kPi), uniform(-kPi, kPi));
+  }
+
+  /// A physical inertia tensor (principal moments y+z, x+z, x+y with second
+  /// moments x, y, z > 0, so the triangle inequality holds) in random body
+  /// axes, scaled by `scale` [kg m^2]. Exactly symmetric.
+  Matrix3<double> inertia(double scale = 1.0)
+  {
+    const double x = uniform(0.05, 1.0), y = uniform(0.05, 1.0), z = uniform(0.05, 1.0);
+    const Eigen::Vector3d moments(y + z, x + z, x + y);
+    const Matrix3<double> Q = rotation();
+    Matrix3<double> I = scale * Q * moments.asDiagonal() * Q.transpose();
+    return Matrix3<double>((I + I.transpose()) / 2.0);
+  }
+
+  Vector6<double> vector6(double scale)
+  {
+    Vector6<double> v;
+    for (int i = 0; i < 6; ++i)
+      v[i] = uniform(-scale, scale);
+    return v;
+  }
+
+private:
+  std::mt19937_64 engine_;
+};
+
+// ---------------------------------------------------------------------------
+// Hard cases (math.md, "Hard cases").
+
+/// Gimbal lock: theta = +-pi/2 (the doubles nearest) and +-pi/2 +- 10^-k,
+/// k = 1..16. For k >= 16 the offset is below half an ulp of pi/2 and the sum
+/// may round back to +-pi/2: that is part of the case.
+inline std::vector<double> gimbalLockThetas()
+{
+  std::vector<double> thetas = { kHalfPi, -kHalfPi };
+  for (int k = 1; k <= 16; ++k)
+  {
+    const double d = std::pow(10.0, -k);
+    for (const double base : { kHalfPi, -kHalfPi })
+    {
+      thetas.push_back(base + d);
+      thetas.push_back(base - d);
+    }
+  }
+  return thetas;
+}
+
+/// The subset of gimbalLockThetas() at which cos^2(theta) is below double
+/// resolution relative to 1, so M is numerically rank 5 (|cos theta| < 1e-8).
+inline bool isNumericallyLocked(double theta)
+{
+  return std::abs(std::cos(theta)) < 1e-8;
+}
+
+/// Angles outside (-pi, pi], up to 1e6 rad.
+inline std::vector<double> largeAngles()
+{
+  return { 1e6, -1e6, 999999.123456789, -987654.321, 123456.789, 31415.9265358979, 1e5 + kHalfPi, 4.0 * kPi, -7.5,
+           1e3 * kPi, 2.0 * kPi * 159154.0 + 0.25 };
+}
+
+/// The angle a reduced to [-pi, pi] exactly (256-bit MPFR, pi to 256 bits),
+/// then rounded to double: the only error is that final rounding, at most
+/// half an ulp of pi (2.2e-16 rad). Compare with std::remainder(a, 2*M_PI),
+/// whose error grows like |a|/(2 pi) * |2 pi - fl(2 pi)| = |a| * 3.9e-17.
+inline double wrapAngleExact(double a)
+{
+  const mp_prec_t prec = 256;
+  const mpfr::mpreal x(a, prec);
+  const mpfr::mpreal two_pi = 2 * mpfr::const_pi(prec);
+  const mpfr::mpreal k = mpfr::round(x / two_pi);
+  return (x - k * two_pi).toDouble();
+}
+
+/// Vertex scales [m]: bodies as small as 1e-6 m and vertices up to 1e4 m
+/// from the COM.
+inline std::vector<double> vertexScales()
+{
+  return { 1e-6, 1e-3, 1.0, 1e2, 1e4 };
+}
+
+// ---------------------------------------------------------------------------
+// Metrics.
+
+template <typename Derived>
+double maxAbs(const Eigen::MatrixBase<Derived>& m)
+{
+  return m.size() == 0 ? 0.0 : static_cast<double>(m.cwiseAbs().maxCoeff());
+}
+
+/// Spacing of doubles at |x| (ulp(1) = 2^-52).
+inline double ulp(double x)
+{
+  x = std::abs(x);
+  return std::nextafter(x, std::numeric_limits<double>::infinity()) - x;
+}
+
+template <typename Derived>
+bool allFinite(const Eigen::MatrixBase<Derived>& m)
+{
+  return m.allFinite();
+}
+
+/// Running maximum, printed at the end of a test so that measured errors are
+/// visible in the log next to the asserted tolerance.
+struct MaxTracker
+{
+  double value = 0.0;
+  void update(double v)
+  {
+    if (!(v <= value))  // also records NaN
+      value = v;
+  }
+};
+
+}  // namespace drb_test

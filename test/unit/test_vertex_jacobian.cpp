@@ -1,0 +1,547 @@
+// Oracle tests for vertex_jacobian.h: p = R p0 + t, J = dp/dq and the
+// vector-Jacobian product (backprop).
+//
+// Oracles:
+//   - the complex step through the templated vertexPosition<std::complex<double>>
+//     (h = 1e-30, derivative = Im(p(q + i h e_j))/h, no cancellation);
+//   - central differences of vertexPosition<double>;
+//   - the long form dp/dr_k = (dR/dr_k) p0 with dR from elementary rotations
+//     (oracles.h), independent of the kernel's cross-product form;
+//   - for backprop: sum_i J_i^T g_i with the long-form J, and the complex step
+//     of the scalar loss L(q) = sum_i g_i . p_i(q).
+//
+// Error measure for J: the rotation block (dp/dr, 3x3) is compared relative
+// to |p0| (= |R p0|, the lever arm). Each entry of the block is bounded by
+// |p0| (unit axis x lever arm) and, because the Y' and Z axes are orthonormal,
+// the block's Frobenius norm is >= |p0|, so the largest entry is >= |p0|/sqrt(6):
+// "relative to |p0|" is "relative to the largest entry" within a factor 2.5.
+// The translation block must be exactly I3.
+#include <cfloat>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include "diff_rigid_body/vertex_jacobian.h"
+#include "oracles.h"
+
+namespace drb = diff_rigid_body;
+using namespace drb_test;
+
+namespace
+{
+// Complex step: the bound, 1e-14 relative to |p0| (~45 ulp); the
+// kernel's and the complex evaluation's roundings are a few ulp each.
+constexpr double kComplexStepTol = 1e-14;
+// Long-form oracle in double: both sides within a few ulp of |p0|.
+constexpr double kLongFormTol = 16 * kEps;
+// Central differences with step h [rad] on the angles: truncation
+// <= h^2/6 |p0| (each angle rotates p about a fixed unit axis, so
+// |d^3p/dr^3| <= |p0|) and rounding <= ~eps |p| / h with |p| <= |p0| + |t|.
+// We allow 6x the truncation bound and 8x the rounding estimate.
+constexpr double kFdStep = 1e-5;  // [rad], and [m] per unit of max(1, |t_j|)
+double fdTolerance(const Vector3<double>& p0, const Vector6<double>& q)
+{
+  return kFdStep * kFdStep * p0.norm() + 8 * kEps * (p0.norm() + q.tail<3>().norm()) / kFdStep;
+}
+// Positions: R p0 is within a few ulp of |p0|, adding t rounds once more.
+constexpr double kPositionTol = 8 * kEps;  // relative to |p0| + |t|
+// Large angles vs the exactly wrapped angle (rounded to double: <= 0.5 ulp(pi)
+// = 2.2e-16 rad, moving p by <= 2.2e-16 |p0|) plus the kernel's few ulp on
+// each side; relative to |p0|.
+constexpr double kWrappedTol = 16 * kEps;
+// Backprop: sums over N vertices. Relative to S = sum_i |p0_i| |g_i| (the
+// rotation part) and sum_i |g_i| (translation); rounding grows ~ N eps in the
+// worst case; with random signs we measure ~1 eps and allow 16 eps.
+constexpr double kBackpropTol = 16 * kEps;
+// Float kernels vs double at the same float inputs, relative to |p0|.
+constexpr double kFloatTol = 16 * FLT_EPSILON;
+
+constexpr int kRandomStates = 1000;
+
+Matrix36<double> kernelJ(const Vector6<double>& q, const Vector3<double>& p0)
+{
+  return drb::vertexJacobian(drb::BodyPose<double>(q), p0);
+}
+
+Vector3<double> kernelP(const Vector6<double>& q, const Vector3<double>& p0)
+{
+  return drb::vertexPosition(drb::BodyPose<double>(q), p0);
+}
+
+/// J by the complex step through vertexPosition<std::complex<double>>.
+Matrix36<double> complexStepJ(const Vector6<double>& q, const Vector3<double>& p0)
+{
+  Matrix36<double> J;
+  const Vector3<Complex> p0c = p0.cast<Complex>();
+  for (int j = 0; j < 6; ++j)
+    J.col(j) = complexStep(
+        [&](const Vector6<Complex>& qc) { return drb::vertexPosition(drb::BodyPose<Complex>(qc), p0c); }, q, j);
+  return J;
+}
+
+/// J by central differences of vertexPosition<double>.
+Matrix36<double> centralDifferenceJ(const Vector6<double>& q, const Vector3<double>& p0,
+                                    Vector3<double> (*position)(const Vector6<double>&, const Vector3<double>&) = kernelP)
+{
+  Matrix36<double> J;
+  for (int j = 0; j < 6; ++j)
+  {
+    const double h = j < 3 ? kFdStep : kFdStep * std::max(1.0, std::abs(q[j]));
+    Vector6<double> qp = q, qm = q;
+    qp[j] += h;
+    qm[j] -= h;
+    J.col(j) = (position(qp, p0) - position(qm, p0)) / (qp[j] - qm[j]);
+  }
+  return J;
+}
+
+double rotationBlockError(const Matrix36<double>& J, const Matrix36<double>& J_ref, const Vector3<double>& p0)
+{
+  return maxAbs(J.leftCols<3>() - J_ref.leftCols<3>()) / p0.norm();
+}
+
+struct Case
+{
+  Vector6<double> q;
+  Vector3<double> p0;
+};
+
+std::vector<Case> randomCases(std::uint64_t seed)
+{
+  Random rng(seed);
+  std::vector<Case> cases;
+  for (int i = 0; i < kRandomStates; ++i)
+  {
+    const Vector6<double> q = rng.state();
+    cases.push_back({ q, rng.vector(1.0) });
+    cases.push_back({ q, rng.vertexOfNorm(rng.logUniform(1e-6, 1e4)) });
+  }
+  return cases;
+}
+
+/// Gimbal lock (every theta of the list, several phi/psi) x vertex scales
+/// (1e-6 m .. 1e4 m). Tiny bodies sit near the origin (t ~ scale) so that
+/// their derivatives are not swamped by |t| in the differences.
+std::vector<Case> gimbalCases(std::uint64_t seed)
+{
+  Random rng(seed);
+  std::vector<Case> cases;
+  for (const double theta : gimbalLockThetas())
+    for (const double scale : vertexScales())
+      for (int n = 0; n < 3; ++n)
+      {
+        Vector6<double> q = rng.state();
+        q[1] = theta;
+        q.tail<3>() = rng.vector(std::min(10.0, 10 * scale));
+        cases.push_back({ q, rng.vertexOfNorm(scale) });
+      }
+  // phi and psi at exact multiples of pi/2 too.
+  for (const double theta : { kHalfPi, -kHalfPi })
+    for (int a = -2; a <= 2; ++a)
+    {
+      Vector6<double> q = Vector6<double>::Zero();
+      q << a * kHalfPi, theta, -a * kHalfPi, 1, 2, 3;
+      cases.push_back({ q, Vector3<double>(0.3, -0.7, 1.1) });
+    }
+  return cases;
+}
+
+void checkAgainstOracles(const std::vector<Case>& cases, const char* label)
+{
+  MaxTracker err_cs, err_long, err_fd_ratio;
+  for (const Case& c : cases)
+  {
+    const Matrix36<double> J = kernelJ(c.q, c.p0);
+    ASSERT_TRUE(J.allFinite());
+    // Translation block: exactly I3, and the complex step gives exactly 1/0.
+    const Matrix36<double> J_cs = complexStepJ(c.q, c.p0);
+    ASSERT_EQ(maxAbs(J.rightCols<3>() - Eigen::Matrix3d::Identity()), 0.0);
+    ASSERT_EQ(maxAbs(J_cs.rightCols<3>() - Eigen::Matrix3d::Identity()), 0.0);
+
+    const double e_cs = rotationBlockError(J, J_cs, c.p0);
+    const double e_long = rotationBlockError(J, refJacobian(c.q, c.p0), c.p0);
+    const double e_fd = maxAbs(J - centralDifferenceJ(c.q, c.p0));
+    const double fd_tol = fdTolerance(c.p0, c.q);
+    err_cs.update(e_cs);
+    err_long.update(e_long);
+    err_fd_ratio.update(e_fd / fd_tol);
+    ASSERT_LE(e_cs, kComplexStepTol) << label << ": q = " << c.q.transpose() << ", p0 = " << c.p0.transpose();
+    ASSERT_LE(e_long, kLongFormTol) << label << ": q = " << c.q.transpose() << ", p0 = " << c.p0.transpose();
+    ASSERT_LE(e_fd, fd_tol) << label << ": q = " << c.q.transpose() << ", p0 = " << c.p0.transpose();
+  }
+  std::printf("[measured] %s (%zu cases): J vs complex step %.3g eps rel |p0|; vs long form %.3g eps; "
+              "central diff at %.2g of its tolerance\n",
+              label, cases.size(), err_cs.value / kEps, err_long.value / kEps, err_fd_ratio.value);
+}
+
+/// The seed's section C as printed, including the missing parentheses in
+/// dx/dphi: p_y sin phi sin psi + cos phi sin th cos psi + p_z (...).
+Matrix36<double> seedJacobianAsPrinted(const Vector6<double>& q, const Vector3<double>& p, bool fix_dx_dphi)
+{
+  const double sf = std::sin(q[0]), cf = std::cos(q[0]);
+  const double st = std::sin(q[1]), ct = std::cos(q[1]);
+  const double ss = std::sin(q[2]), cs = std::cos(q[2]);
+  const double px = p[0], py = p[1], pz = p[2];
+  Matrix36<double> J = Matrix36<double>::Zero();
+  J.rightCols<3>().setIdentity();
+  // dx/dpsi, dx/dtheta, dx/dphi
+  J(0, 2) = -px * ct * ss + py * (-cf * cs - sf * st * ss) + pz * (sf * cs - cf * st * ss);
+  J(0, 1) = -px * st * cs + py * sf * ct * cs + pz * cf * ct * cs;
+  J(0, 0) = fix_dx_dphi ? py * (sf * ss + cf * st * cs) + pz * (cf * ss - sf * st * cs)
+                        : py * sf * ss + cf * st * cs + pz * (cf * ss - sf * st * cs);  // as printed
+  // dy/dpsi, dy/dtheta, dy/dphi
+  J(1, 2) = px * ct * cs + py * (-cf * ss + sf * st * cs) + pz * (sf * ss + cf * st * cs);
+  J(1, 1) = -px * st * ss + py * sf * ct * ss + pz * cf * ct * ss;
+  J(1, 0) = py * (-sf * cs + cf * st * ss) + pz * (-cf * cs - sf * st * ss);
+  // dz/dpsi, dz/dtheta, dz/dphi
+  J(2, 2) = 0;
+  J(2, 1) = -px * ct - py * sf * st - pz * cf * st;
+  J(2, 0) = py * cf * ct - pz * sf * ct;
+  return J;
+}
+
+std::vector<double> randomGradients(Random& rng, std::size_t count)
+{
+  std::vector<double> g(3 * count);
+  for (double& x : g)
+    x = rng.uniform(-1.0, 1.0);
+  return g;
+}
+
+struct BackpropCheck
+{
+  double rotation_error;     // relative to sum |p0_i| |g_i|
+  double translation_error;  // relative to sum |g_i|
+  double loss_cs_error;      // complex step of L, relative as above
+};
+
+/// Checks backpropagateVertexGradients(indices) against sum_i J_i^T g_i with
+/// the long-form J and against the complex step of L = sum_i g_i . p_i(q).
+BackpropCheck checkBackprop(const Vector6<double>& q, const drb::Matrix3X<double>& vertices,
+                            const std::vector<std::uint32_t>& indices, const std::vector<double>& g)
+{
+  const std::size_t count = indices.empty() ? static_cast<std::size_t>(vertices.cols()) : indices.size();
+  EXPECT_EQ(g.size(), 3 * count);
+  const Vector6<double> dL = drb::backpropagateVertexGradients(drb::BodyPose<double>(q), vertices, indices, g.data());
+
+  Vector6<double> expected = Vector6<double>::Zero();
+  double torque_scale = 0, force_scale = 0;
+  Complex loss_at[6] = {};
+  Vector6<Complex> qc[6];
+  for (int j = 0; j < 6; ++j)
+    qc[j] = complexPerturbed(q, j);
+  for (std::size_t n = 0; n < count; ++n)
+  {
+    const Eigen::Index v = indices.empty() ? static_cast<Eigen::Index>(n) : indices[n];
+    const Vector3<double> p0 = vertices.col(v);
+    const Vector3<double> gi(g[3 * n], g[3 * n + 1], g[3 * n + 2]);
+    expected += refJacobian(q, p0).transpose() * gi;
+    torque_scale += p0.norm() * gi.norm();
+    force_scale += gi.norm();
+    for (int j = 0; j < 6; ++j)
+      // (Not .dot(): Eigen's dot conjugates its left operand.)
+      loss_at[j] += refPosition(qc[j], Vector3<Complex>(p0.cast<Complex>())).cwiseProduct(gi.cast<Complex>()).sum();
+  }
+  Vector6<double> dL_cs;
+  for (int j = 0; j < 6; ++j)
+    dL_cs[j] = loss_at[j].imag() / kComplexStepH;
+  EXPECT_TRUE(dL.allFinite());
+  return { maxAbs(dL.head<3>() - expected.head<3>()) / torque_scale,
+           maxAbs(dL.tail<3>() - expected.tail<3>()) / force_scale,
+           std::max(maxAbs(dL.head<3>() - dL_cs.head<3>()) / torque_scale,
+                    maxAbs(dL.tail<3>() - dL_cs.tail<3>()) / force_scale) };
+}
+
+drb::Matrix3X<double> randomVertices(Random& rng, int count, double scale)
+{
+  drb::Matrix3X<double> v(3, count);
+  for (int i = 0; i < count; ++i)
+    v.col(i) = rng.vector(scale);
+  return v;
+}
+}  // namespace
+
+// ---------------------------------------------------------------------------
+
+TEST(VertexJacobian, PositionMatchesProductForm)
+{
+  MaxTracker err;
+  for (const auto& cases : { randomCases(201), gimbalCases(202) })
+    for (const Case& c : cases)
+    {
+      const double scale = c.p0.norm() + c.q.tail<3>().norm();
+      const double e = maxAbs(kernelP(c.q, c.p0) - refPosition(c.q, c.p0)) / scale;
+      err.update(e);
+      ASSERT_LE(e, kPositionTol) << "q = " << c.q.transpose() << ", p0 = " << c.p0.transpose();
+    }
+  std::printf("[measured] |p - (Rz Ry Rx p0 + t)| = %.3g eps rel (|p0| + |t|)\n", err.value / kEps);
+}
+
+TEST(VertexJacobian, MatchesOraclesAtRandomStates)
+{
+  checkAgainstOracles(randomCases(203), "random states");
+}
+
+TEST(VertexJacobian, MatchesOraclesAtGimbalLock)
+{
+  checkAgainstOracles(gimbalCases(204), "gimbal lock x vertex scales");
+}
+
+// Angles up to 1e6 rad: J agrees with the complex step there, and with J at
+// the exactly wrapped angle within the argument-reduction error.
+TEST(VertexJacobian, LargeAnglesMatchComplexStepAndWrappedAngle)
+{
+  Random rng(205);
+  std::vector<Case> cases;
+  const auto angles = largeAngles();
+  const int last = static_cast<int>(angles.size()) - 1;
+  for (const double a : angles)
+    for (const double scale : vertexScales())
+    {
+      for (int axis = 0; axis < 3; ++axis)
+      {
+        Vector6<double> q = rng.state();
+        q[axis] = a;
+        q.tail<3>() = rng.vector(std::min(10.0, 10 * scale));
+        cases.push_back({ q, rng.vertexOfNorm(scale) });
+      }
+      // All three angles large at once.
+      Vector6<double> q;
+      q << a, angles[rng.integer(0, last)], angles[rng.integer(0, last)],
+          rng.vector(std::min(10.0, 10 * scale));
+      cases.push_back({ q, rng.vertexOfNorm(scale) });
+    }
+  checkAgainstOracles(cases, "angles up to 1e6 rad");
+
+  MaxTracker err;
+  for (const Case& c : cases)
+  {
+    Vector6<double> q_wrapped = c.q;
+    for (int k = 0; k < 3; ++k)
+      q_wrapped[k] = wrapAngleExact(c.q[k]);
+    const double e_J = rotationBlockError(kernelJ(c.q, c.p0), kernelJ(q_wrapped, c.p0), c.p0);
+    const double e_p = maxAbs(kernelP(c.q, c.p0) - kernelP(q_wrapped, c.p0)) / (c.p0.norm() + c.q.tail<3>().norm());
+    err.update(std::max(e_J, e_p));
+    ASSERT_LE(e_J, kWrappedTol) << "q = " << c.q.transpose();
+    ASSERT_LE(e_p, kWrappedTol) << "q = " << c.q.transpose();
+  }
+  std::printf("[measured] large angles vs exact wrap: %.3g eps\n", err.value / kEps);
+}
+
+// The batch kernel writes row-major 3x6 blocks and the positions, for all
+// vertices or for an index list (with repeats), and skips null outputs.
+TEST(VertexJacobian, BatchLayoutMatchesOracle)
+{
+  Random rng(206);
+  const Vector6<double> q = rng.state();
+  const drb::Matrix3X<double> vertices = randomVertices(rng, 20, 2.0);
+  const drb::BodyPose<double> pose(q);
+  for (const std::vector<std::uint32_t>& indices :
+       { std::vector<std::uint32_t>{}, std::vector<std::uint32_t>{ 7, 0, 7, 19, 3, 3, 3, 12 } })
+  {
+    const std::size_t count = indices.empty() ? 20 : indices.size();
+    std::vector<double> positions(3 * count, -999.0), jacobians(18 * count, -999.0);
+    drb::vertexPositionsAndJacobians(pose, vertices, indices, positions.data(), jacobians.data());
+    for (std::size_t n = 0; n < count; ++n)
+    {
+      const Vector3<double> p0 = vertices.col(indices.empty() ? n : indices[n]);
+      const Matrix36<double> J_ref = refJacobian(q, p0);
+      const Vector3<double> p_ref = refPosition(q, p0);
+      for (int i = 0; i < 3; ++i)
+      {
+        EXPECT_NEAR(positions[3 * n + i], p_ref[i], kPositionTol * (p0.norm() + q.tail<3>().norm()))
+            << "vertex " << n << " row " << i;
+        for (int j = 0; j < 6; ++j)
+          EXPECT_NEAR(jacobians[18 * n + 6 * i + j], J_ref(i, j), kLongFormTol * p0.norm())
+              << "vertex " << n << " entry (" << i << "," << j << ")";
+      }
+    }
+    // Null outputs are skipped; the other output is unchanged.
+    std::vector<double> only_positions(3 * count, -999.0), only_jacobians(18 * count, -999.0);
+    drb::vertexPositionsAndJacobians(pose, vertices, indices, only_positions.data(), static_cast<double*>(nullptr));
+    drb::vertexPositionsAndJacobians(pose, vertices, indices, static_cast<double*>(nullptr), only_jacobians.data());
+    EXPECT_EQ(only_positions, positions);
+    EXPECT_EQ(only_jacobians, jacobians);
+  }
+}
+
+// ---------------------------------------------------------------------------
+// Backprop.
+
+TEST(Backprop, AllVerticesMatchesJTransposeGAndComplexStep)
+{
+  Random rng(301);
+  MaxTracker err_rot, err_trans, err_cs;
+  for (int s = 0; s < 200; ++s)
+  {
+    const Vector6<double> q = rng.state();
+    const drb::Matrix3X<double> vertices = randomVertices(rng, 64, rng.logUniform(1e-3, 1e3));
+    const BackpropCheck r = checkBackprop(q, vertices, {}, randomGradients(rng, 64));
+    err_rot.update(r.rotation_error);
+    err_trans.update(r.translation_error);
+    err_cs.update(r.loss_cs_error);
+    ASSERT_LE(r.rotation_error, kBackpropTol) << "q = " << q.transpose();
+    ASSERT_LE(r.translation_error, kBackpropTol) << "q = " << q.transpose();
+    ASSERT_LE(r.loss_cs_error, kBackpropTol) << "q = " << q.transpose();
+  }
+  std::printf("[measured] backprop (all 64 vertices): rotation %.3g eps, translation %.3g eps, "
+              "vs complex step of L %.3g eps\n",
+              err_rot.value / kEps, err_trans.value / kEps, err_cs.value / kEps);
+}
+
+TEST(Backprop, IndexSubsetWithRepeats)
+{
+  Random rng(302);
+  const std::vector<std::uint32_t> indices = { 5, 0, 5, 63, 17, 17, 17, 2, 40, 5 };
+  MaxTracker err;
+  for (int s = 0; s < 200; ++s)
+  {
+    const Vector6<double> q = rng.state();
+    const drb::Matrix3X<double> vertices = randomVertices(rng, 64, 1.0);
+    const BackpropCheck r = checkBackprop(q, vertices, indices, randomGradients(rng, indices.size()));
+    err.update(std::max({ r.rotation_error, r.translation_error, r.loss_cs_error }));
+    ASSERT_LE(r.rotation_error, kBackpropTol) << "q = " << q.transpose();
+    ASSERT_LE(r.translation_error, kBackpropTol) << "q = " << q.transpose();
+    ASSERT_LE(r.loss_cs_error, kBackpropTol) << "q = " << q.transpose();
+  }
+  // A subset is not the same as all vertices: the gradient of vertex 5
+  // counts three times.
+  const Vector6<double> q = rng.state();
+  const drb::Matrix3X<double> vertices = randomVertices(rng, 64, 1.0);
+  const std::vector<double> g = randomGradients(rng, indices.size());
+  std::vector<double> g_all(3 * 64, 0.0);
+  for (std::size_t n = 0; n < indices.size(); ++n)
+    for (int i = 0; i < 3; ++i)
+      g_all[3 * indices[n] + i] += g[3 * n + i];
+  const drb::BodyPose<double> pose(q);
+  const Vector6<double> subset = drb::backpropagateVertexGradients(pose, vertices, indices, g.data());
+  const Vector6<double> scattered = drb::backpropagateVertexGradients(pose, vertices, {}, g_all.data());
+  EXPECT_LE(maxAbs(subset - scattered), 1e-14 * (1 + maxAbs(scattered)));
+  std::printf("[measured] backprop (subset with repeats): %.3g eps\n", err.value / kEps);
+}
+
+TEST(Backprop, HardCases)
+{
+  Random rng(303);
+  MaxTracker err;
+  std::vector<Vector6<double>> states;
+  for (const double theta : gimbalLockThetas())
+  {
+    Vector6<double> q = rng.state();
+    q[1] = theta;
+    states.push_back(q);
+  }
+  for (const double a : largeAngles())
+  {
+    Vector6<double> q = rng.state();
+    q[rng.integer(0, 2)] = a;
+    states.push_back(q);
+  }
+  for (const Vector6<double>& q : states)
+    for (const double scale : vertexScales())
+    {
+      const drb::Matrix3X<double> vertices = randomVertices(rng, 16, scale);
+      const BackpropCheck r = checkBackprop(q, vertices, { 3, 3, 0, 15 }, randomGradients(rng, 4));
+      const double e = std::max({ r.rotation_error, r.translation_error, r.loss_cs_error });
+      err.update(e);
+      ASSERT_LE(e, kBackpropTol) << "q = " << q.transpose() << ", scale " << scale;
+    }
+  std::printf("[measured] backprop hard cases: %.3g eps\n", err.value / kEps);
+}
+
+TEST(Backprop, EmptySelectionGivesZero)
+{
+  const drb::Matrix3X<double> none(3, 0);
+  const Vector6<double> dL =
+      drb::backpropagateVertexGradients(drb::BodyPose<double>(Vector6<double>::Ones()), none, {}, static_cast<const double*>(nullptr));
+  EXPECT_EQ(dL, Vector6<double>::Zero());
+}
+
+// ---------------------------------------------------------------------------
+// Seed typo regression: the seed prints dx/dphi without its parentheses,
+//   p_y sin phi sin psi + cos phi sin th cos psi + p_z (...)
+// (and the paper's published code has the same error). The formula as printed
+// differs from the truth by (1 - p_y) cos phi sin th cos psi, so it must be
+// caught whenever p_y != 1 and that product is not small.
+TEST(SeedTypos, PrintedDxDphiFailsFiniteDifferencesAndOursPasses)
+{
+  Random rng(401);
+  int caught = 0, states = 0;
+  MaxTracker seed_other_entries;
+  for (int s = 0; s < 100; ++s)
+  {
+    const Vector6<double> q = rng.state();
+    Vector3<double> p0 = rng.vector(2.0);
+    if (std::abs((1 - p0[1]) * std::cos(q[0]) * std::sin(q[1]) * std::cos(q[2])) < 0.05)
+      continue;  // the typo is invisible (or too small to see by FD) there
+    ++states;
+    const Matrix36<double> J_fd = centralDifferenceJ(q, p0, refPosition<double>);
+    const double tol = fdTolerance(p0, q);
+    const Matrix36<double> seed = seedJacobianAsPrinted(q, p0, false);
+    const Matrix36<double> seed_fixed = seedJacobianAsPrinted(q, p0, true);
+    // The printed dx/dphi is caught by the same FD check that J passes...
+    if (std::abs(seed(0, 0) - J_fd(0, 0)) > 1000 * tol)
+      ++caught;
+    // ...and it is the only wrong entry of section C.
+    Matrix36<double> seed_rest = seed - J_fd;
+    seed_rest(0, 0) = 0;
+    seed_other_entries.update(maxAbs(seed_rest) / tol);
+    EXPECT_LE(maxAbs(seed_rest), tol) << "q = " << q.transpose();
+    EXPECT_LE(maxAbs(seed_fixed - J_fd), tol) << "q = " << q.transpose();
+    EXPECT_LE(maxAbs(kernelJ(q, p0) - J_fd), tol) << "q = " << q.transpose();
+    // Ours equals the parenthesised closed form to rounding.
+    EXPECT_LE(maxAbs(kernelJ(q, p0) - seed_fixed) / p0.norm(), kLongFormTol) << "q = " << q.transpose();
+  }
+  ASSERT_GT(states, 50);
+  EXPECT_EQ(caught, states) << "the FD check must reject the printed dx/dphi at every state used";
+  std::printf("[measured] seed dx/dphi rejected at %d/%d states; other section-C entries at %.2g of FD tol\n", caught,
+              states, seed_other_entries.value);
+}
+
+// ---------------------------------------------------------------------------
+
+TEST(VertexJacobian, FloatAgreesWithDouble)
+{
+  Random rng(501);
+  MaxTracker err_J, err_p, err_bp;
+  for (int s = 0; s < 1000; ++s)
+  {
+    const Vector6<float> qf = rng.state().cast<float>();
+    const Vector6<double> q = qf.cast<double>();
+    const Vector3<float> p0f = rng.vertexOfNorm(rng.logUniform(1e-3, 1e3)).cast<float>();
+    const Vector3<double> p0 = p0f.cast<double>();
+    const drb::BodyPose<float> pose_f(qf);
+    const drb::BodyPose<double> pose(q);
+    const double e_J =
+        maxAbs(drb::vertexJacobian(pose_f, p0f).cast<double>() - drb::vertexJacobian(pose, p0)) / p0.norm();
+    const double e_p = maxAbs(drb::vertexPosition(pose_f, p0f).cast<double>() - drb::vertexPosition(pose, p0)) /
+                       (p0.norm() + q.tail<3>().norm());
+    // Backprop over 8 vertices.
+    drb::Matrix3X<float> vf(3, 8);
+    std::vector<float> gf(24);
+    for (int i = 0; i < 8; ++i)
+      vf.col(i) = rng.vector(1.0).cast<float>();
+    for (float& x : gf)
+      x = static_cast<float>(rng.uniform(-1, 1));
+    const std::vector<double> gd(gf.begin(), gf.end());
+    const drb::Matrix3X<double> vd = vf.cast<double>();
+    double bp_scale = 0;  // sum |p0_i| |g_i| + sum |g_i|
+    for (int i = 0; i < 8; ++i)
+      bp_scale += (vd.col(i).norm() + 1) * Eigen::Vector3d(gd[3 * i], gd[3 * i + 1], gd[3 * i + 2]).norm();
+    const double e_bp = maxAbs(drb::backpropagateVertexGradients(pose_f, vf, {}, gf.data()).cast<double>() -
+                               drb::backpropagateVertexGradients(pose, vd, {}, gd.data())) /
+                        bp_scale;
+    err_J.update(e_J);
+    err_p.update(e_p);
+    err_bp.update(e_bp);
+    ASSERT_LE(e_J, kFloatTol) << "q = " << q.transpose();
+    ASSERT_LE(e_p, kFloatTol) << "q = " << q.transpose();
+    ASSERT_LE(e_bp, kFloatTol) << "q = " << q.transpose();
+  }
+  std::printf("[measured] float vs double: J %.3g, p %.3g, backprop %.3g float eps\n", err_J.value / FLT_EPSILON,
+              err_p.value / FLT_EPSILON, err_bp.value / FLT_EPSILON);
+}
