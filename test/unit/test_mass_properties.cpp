@@ -508,12 +508,13 @@ TEST(MassPropertiesMesh, BoxMeshMatchesClosedForm)
 TEST(MassPropertiesMesh, FarAwayRotatedBoxMeshIsStillExact)
 {
   // Vertices 1e3 m and 1e4 m from the origin: rounding the vertices alone
-  // moves them by ~|t| eps = 2e-12 m on a 0.3 m box, i.e. a relative change in
-  // the inertia of ~1e-11. Without subtracting a reference point the signed
-  // tetrahedra from the origin cancel ~|t|^2/size^2 = 1e9..1e11-fold and the
-  // inertia is wrong in the 3rd-6th digit.
-  constexpr double FAR_INERTIA_REL_TOL = 1e-9;  // relative
-  constexpr double FAR_COM_REL_TOL = 1e-14;     // relative to |t|
+  // moves them by up to |t| eps = 2e-12 m on a 0.3 m box, a relative change
+  // in the inertia of ~1e-11 (measured 9e-14 at 1e3 m, 1.4e-12 at 1e4 m).
+  // Without subtracting a reference point the signed tetrahedra from the
+  // origin cancel ~|t|^2/size^2 = 1e7..1e9-fold and the inertia loses most
+  // of its digits.
+  constexpr double FAR_INERTIA_REL_TOL = 1e-10;  // relative
+  constexpr double FAR_COM_REL_TOL = 1e-14;      // relative to |t|
   const double density = 2700.0;                // kg/m^3
   const Eigen::Vector3d size(0.3, 0.5, 0.7);
   const MassProperties closed = boxMassProperties(density, size);
@@ -852,8 +853,8 @@ TEST(MassPropertiesParticles, BunnyExactIntegralAgainstMillionParticles)
   constexpr double MASS_REL_TOL = 5e-4;     // relative
   constexpr double COM_REL_TOL = 1.5e-4;    // relative to the bounding-box diagonal
   constexpr double INERTIA_REL_TOL = 8e-4;  // relative
-  constexpr double TIME_LIMIT = 5.0;        // s, for 1e6 samples (measured 0.04 s, -O2)
-  constexpr double FAR_REL_TOL = 1e-9;      // relative, moved 1.5e3 m away
+  constexpr double FAR_REL_TOL = 1e-10;     // relative, moved 1.5e3 m away (measured 5e-14)
+  constexpr double SAMPLE_COUNT_REL_TOL = 1e-3;  // samples vs target (measured 1.9e-4)
   const double density = 1000.0;             // kg/m^3
   const MassProperties exact = meshMassProperties(density, bunny, "bunny");
   const auto start = std::chrono::steady_clock::now();
@@ -865,11 +866,13 @@ TEST(MassPropertiesParticles, BunnyExactIntegralAgainstMillionParticles)
   const double inertia_error = relativeError(particles.mass_properties.inertia, exact.inertia);
   std::printf("bunny: %zu samples in %.3f s; mass %.3g com %.3g inertia %.3g\n", particles.num_samples, seconds,
               mass_error, com_error, inertia_error);
+  // Timing is reported, never asserted (machines are noisy): see docs/benchmarks.md.
   RecordProperty("particle_seconds_1e6", std::to_string(seconds));
+  EXPECT_NEAR(static_cast<double>(particles.num_samples), 1e6, SAMPLE_COUNT_REL_TOL * 1e6);
+  EXPECT_NEAR(particles.mass_properties.mass, particles.particle_mass * particles.num_samples, 1e-12 * exact.mass);
   EXPECT_LT(mass_error, MASS_REL_TOL);
   EXPECT_LT(com_error, COM_REL_TOL);
   EXPECT_LT(inertia_error, INERTIA_REL_TOL);
-  EXPECT_LT(seconds, TIME_LIMIT);
   // The exact integral does not care where the bunny is.
   Eigen::Isometry3d far = Eigen::Isometry3d::Identity();
   far.translation() = Eigen::Vector3d(1e3, -1e3, 5e2);
