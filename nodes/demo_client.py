@@ -1,64 +1,98 @@
 #!/usr/bin/python3
-"""Calls every service of rigid_body_server once and prints what comes back."""
-import math
+"""The README's example client: two optimisers and a batched trajectory,
+against a running rigid_body_server (the default scene).
+
+1. Pose fitting: target vertex positions of one body at a hidden pose (with
+   and without noise); recover q from a start 30 deg and 0.2 m away by
+   Gauss-Newton (get_vertex_jacobians) and by L-BFGS (backprop).
+2. Kinetic energy E = 1/2 qdot^T M(q) qdot along a K-configuration
+   trajectory: one batched get_mass_matrix call against K calls.
+
+Usage: demo_client.py [--body knot] [--noise 0.001] [--configurations 1000]
+"""
+import argparse
+import os
 import sys
 
-import rospy
-from diff_rigid_body.msg import BodyState
-from diff_rigid_body.srv import (Backprop, GetBodies, GetMassMatrix, GetState, GetVertexJacobians,
-                                 SetState)
+try:
+    import rospy
+except ImportError:  # a private python3 without ROS came first on PATH: use Debian's
+    if os.path.realpath(sys.executable) != os.path.realpath('/usr/bin/python3'):
+        os.execv('/usr/bin/python3', ['/usr/bin/python3'] + sys.argv)
+    raise
+import numpy as np
 
-SERVER = "/rigid_body_server"
+from diff_rigid_body.client import DiffRigidBodyError, RigidBodyClient
+from diff_rigid_body import pose_fitting, trajectory_energy
 
-
-def proxy(name, service_type):
-    rospy.wait_for_service(f"{SERVER}/{name}", timeout=30.0)
-    return rospy.ServiceProxy(f"{SERVER}/{name}", service_type, persistent=True)
-
-
-def check(response, what):
-    if not response.success:
-        raise RuntimeError(f"{what}: {response.message}")
-    return response
+Q_HIDDEN = np.array([0.3, -0.4, 1.1, 0.05, -0.1, 0.6])  # the pose to recover
 
 
-def matrix(values, rows, cols):
-    return "\n".join("    " + " ".join(f"{values[r * cols + c]: .6e}" for c in range(cols)) for r in range(rows))
+def print_scene(client):
+    bodies = client.bodies()
+    print("Scene (fixed frame '%s'):" % bodies.fixed_frame)
+    for i, name in enumerate(bodies.names):
+        diagonal = ', '.join('%.3e' % v for v in np.diag(bodies.inertias[i]))
+        print('  %-6s %8.5f kg  %5d vertices  I_b diagonal (%s) kg m^2' % (
+            name, bodies.masses[i], bodies.vertex_counts[i], diagonal))
+    return bodies
+
+
+def pose_fitting_example(client, body, noises):
+    print('\n1. Pose fitting of %r: hidden q = %s' % (body, np.array2string(Q_HIDDEN, precision=3)))
+    print('   %-26s %7s %6s %6s %12s %13s %13s %9s' % (
+        'solver', 'noise', 'iters', 'calls', 'rms resid', 'angle error', 'pos error', 'time'))
+    for noise in noises:
+        target, q_start = pose_fitting.make_problem(client, body, Q_HIDDEN, noise=noise, seed=3)
+        angle, distance = pose_fitting.pose_error(q_start, Q_HIDDEN)
+        print('   start: %.1f deg and %.3f m away (noise %g m)' % (np.degrees(angle), distance, noise))
+        for label, fit in (('Gauss-Newton (jacobians)', pose_fitting.fit_gauss_newton),
+                           ('L-BFGS (backprop)', pose_fitting.fit_lbfgs)):
+            result = fit(client, body, target, q_start)
+            angle, distance = pose_fitting.pose_error(result.q, Q_HIDDEN)
+            print('   %-26s %7g %6d %6d %10.3e m %9.3e rad %11.3e m %7.3f s%s' % (
+                label, noise, result.iterations, result.evaluations, result.residual_rms, angle, distance,
+                result.wall_time, '' if result.converged else '  (NOT CONVERGED: %s)' % result.reason))
+
+
+def trajectory_example(client, bodies, count):
+    q0 = np.array([client.get_state()[name] for name in bodies.names])
+    t, q, qdot = trajectory_energy.demo_trajectory(q0, count)
+    print('\n2. Kinetic energy along a trajectory: K = %d configurations of %d bodies (%s), %.1f s' % (
+        count, len(bodies.names), ', '.join(bodies.names), t[-1]))
+    batched, batched_time = trajectory_energy.energy_batched(client, bodies.names, q, qdot, repeat=3)
+    per_call, per_call_time = trajectory_energy.energy_per_call(client, bodies.names, q, qdot)
+    oracle = trajectory_energy.energy_from_inertia(bodies.masses, bodies.inertias, q, qdot)
+    for i, name in enumerate(bodies.names):
+        print('   %-6s E in [%.4e, %.4e] J, mean %.4e J' % (name, batched[:, i].min(), batched[:, i].max(),
+                                                             batched[:, i].mean()))
+    print('   one batched call: %8.4f s   (best of 3; M comes back as K x n x 6 x 6)' % batched_time)
+    print('   %d single calls: %8.4f s   speed-up %.0fx' % (count, per_call_time, per_call_time / batched_time))
+    print('   max relative difference, batched vs single calls:      %.2e' % np.max(
+        np.abs(batched - per_call) / np.abs(per_call)))
+    print('   max relative difference vs 1/2 w^T I w + 1/2 m |v|^2:   %.2e' % np.max(
+        np.abs(batched - oracle) / np.abs(oracle)))
 
 
 def main():
-    rospy.init_node("demo_client")
-    bodies = check(proxy("get_bodies", GetBodies)(), "get_bodies")
-    print(f"fixed frame '{bodies.fixed_frame}', bodies:")
-    for i, name in enumerate(bodies.names):
-        print(f"  {name}: mass {bodies.masses[i]:.6g} kg, {bodies.vertex_counts[i]} vertices, "
-              f"COM offset {list(bodies.com_offsets[3 * i:3 * i + 3])}")
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument('--server', default='rigid_body_server')
+    parser.add_argument('--body', default='knot', help='body to fit (default: knot)')
+    parser.add_argument('--noise', type=float, default=1e-3, help='[m] noise of the noisy fit (default: 1 mm)')
+    parser.add_argument('--configurations', type=int, default=1000, help='K (default: 1000)')
+    args = parser.parse_args(rospy.myargv()[1:])
+    rospy.init_node('demo_client', anonymous=True)
 
-    body = bodies.names[0]
-    state = check(proxy("get_state", GetState)(bodies=[body]), "get_state").states[0]
-    q = list(state.q)
-    print(f"\nq({body}) = {q}")
-    q[1] = math.pi / 2 - 1e-3  # close to gimbal lock
-    check(proxy("set_state", SetState)(states=[BodyState(name=body, q=q)]), "set_state")
-    print(f"set_state: theta = pi/2 - 1e-3")
-
-    mass = check(proxy("get_mass_matrix", GetMassMatrix)(bodies=[body], q=[], derivatives=True),
-                 "get_mass_matrix")
-    print(f"\nM(q) of {body} (cos theta = {mass.cos_theta[0]:.3e}):\n{matrix(mass.mass_matrices, 6, 6)}")
-    print(f"dM/dtheta:\n{matrix(mass.derivatives[36:72], 6, 6)}")
-
-    jac = check(proxy("get_vertex_jacobians", GetVertexJacobians)(body=body, vertices=[0, 1], q=[]),
-                "get_vertex_jacobians")
-    print(f"\nvertex 0 at {jac.positions[0:3]}\nJ_0 = dp/dq:\n{matrix(jac.jacobians[0:18], 3, 6)}")
-
-    gradient = check(proxy("backprop", Backprop)(body=body, vertices=[0, 1], gradients=[0, 0, 1, 0, 0, 1], q=[]),
-                     "backprop")
-    print(f"\nbackprop of L = z_0 + z_1: dL/dq = {list(gradient.gradient)}")
-
-    refused = proxy("get_vertex_jacobians", GetVertexJacobians)(body="no_such_body", vertices=[], q=[])
-    print(f"\nan unknown body is refused: success={refused.success}, message='{refused.message}'")
+    client = RigidBodyClient(args.server).connect()  # persistent connections, opened before any timing
+    bodies = print_scene(client)
+    pose_fitting_example(client, args.body, [0.0, args.noise])
+    trajectory_example(client, bodies, args.configurations)
+    try:
+        client.vertex_jacobians('no_such_body')
+    except DiffRigidBodyError as e:
+        print('\nA refused request raises DiffRigidBodyError: %s' % e)
     return 0
 
 
-if __name__ == "__main__":
+if __name__ == '__main__':
     sys.exit(main())

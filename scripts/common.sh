@@ -21,6 +21,13 @@ DRB_APT_PACKAGES=(
   libeigen3-dev libassimp-dev libtinyxml2-dev
   libmpfrc++-dev libmpfr-dev libgmp-dev liborocos-kdl-dev libkdl-parser-dev libmujoco-dev libbenchmark-dev
   python3-numpy python3-yaml
+  python3-matplotlib
+  # clients and rviz: the Python client, rviz, and the headless screenshot
+  # (xvfb-run needs xauth; software OpenGL comes from the Mesa DRI drivers)
+  python3-rospy rviz xvfb xauth imagemagick libgl1-mesa-dri
+  # reliability: libFuzzer targets (clang, libFuzzer and the sanitizer
+  # runtimes) and symbolised sanitizer reports (scripts/fuzz)
+  clang libclang-rt-14-dev llvm
 )
 
 drb_log() { printf '\033[1m[diff_rigid_body]\033[0m %s\n' "$*" >&2; }
@@ -46,6 +53,11 @@ drb_setup() {
 drb_build() {
   mkdir -p "${DRB_WORKSPACE}/src"
   ln -sfn "${DRB_REPO}" "${DRB_WORKSPACE}/src/diff_rigid_body"
+  # The default workspace lives inside the checkout: keep rospack and catkin
+  # from crawling back into it through the src/ link ("File system loop").
+  if [[ -d "${DRB_REPO}/.build" ]]; then
+    touch "${DRB_REPO}/.build/CATKIN_IGNORE" "${DRB_REPO}/.build/rospack_nosubdirs"
+  fi
   drb_log "building in ${DRB_WORKSPACE}"
   (cd "${DRB_WORKSPACE}" && catkin_make -DCMAKE_BUILD_TYPE=Release "$@" -j"${DRB_JOBS}" >&2)
   # shellcheck disable=SC1091

@@ -30,9 +30,9 @@ struct MassProperties
 constexpr double kInertiaSymmetryTolerance = 1e-9;
 
 /// Throws InvalidInertiaError unless
-///   - mass is finite and > 0 [kg];
+///   - mass is finite and > 0 [kg], and not subnormal (>= DBL_MIN);
 ///   - the tensor is finite and symmetric;
-///   - its eigenvalues (principal moments) are > 0;
+///   - its eigenvalues (principal moments) are > 0, and not subnormal;
 ///   - they satisfy the triangle inequality I1 + I2 >= I3 - eps with
 ///     eps = 16 DBL_EPSILON max(1, trace/2) (Drake's tolerance).
 /// `where` names the link or body, and appears in every message.

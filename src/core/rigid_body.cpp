@@ -37,6 +37,11 @@ void validateMassProperties(const std::string& where, double mass, const Eigen::
     why << where << ": mass must be > 0 kg, got " << mass;
     throw InvalidInertiaError(why.str());
   }
+  if (mass < DBL_MIN)  // subnormal: m x rounds away, so the COM and inertia would be silently wrong
+  {
+    why << where << ": mass must be a normal number (>= " << DBL_MIN << " kg), got " << mass;
+    throw InvalidInertiaError(why.str());
+  }
   if (!inertia.allFinite())
   {
     why << where << ": inertia must be finite, got " << formatMatrix(inertia);
@@ -56,6 +61,12 @@ void validateMassProperties(const std::string& where, double mass, const Eigen::
   {
     why << where << ": inertia must be positive-definite, but its smallest principal moment is " << moments[0]
         << " kg m^2 in " << formatMatrix(inertia);
+    throw InvalidInertiaError(why.str());
+  }
+  if (moments[0] < DBL_MIN)
+  {
+    why << where << ": principal moments must be normal numbers (>= " << DBL_MIN
+        << " kg m^2), but the smallest is " << moments[0] << " kg m^2 in " << formatMatrix(inertia);
     throw InvalidInertiaError(why.str());
   }
   const double eps = 16.0 * DBL_EPSILON * std::max(1.0, moments.sum() / 2.0);

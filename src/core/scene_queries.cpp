@@ -1,5 +1,6 @@
 #include "diff_rigid_body/scene_queries.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <unordered_set>
@@ -48,6 +49,8 @@ SceneQueries::SceneQueries(Scene scene) : scene_(std::move(scene))
 {
   for (const SceneBody& body : scene_.bodies)
     vertex_radius_.push_back(body.body.vertices.cols() ? body.body.vertices.colwise().norm().maxCoeff() : 0.0);
+  for (std::size_t i = 0; i < scene_.bodies.size(); ++i)
+    body_index_.emplace(scene_.bodies[i].body.name, i);  // the first of equal names, as Scene::findBody
 }
 
 SceneState SceneQueries::initialState() const
@@ -61,13 +64,18 @@ SceneState SceneQueries::initialState() const
 
 std::size_t SceneQueries::bodyIndex(const std::string& name, const std::string& field) const
 {
-  const int index = scene_.findBody(name);
-  if (index >= 0)
-    return static_cast<std::size_t>(index);
+  const auto found = body_index_.find(name);
+  if (found != body_index_.end())
+    return found->second;
+  // At most 20 names, so that a large scene does not make every refusal huge.
+  constexpr std::size_t kListed = 20;
   std::string known;
-  for (const SceneBody& body : scene_.bodies)
-    known += (known.empty() ? "" : ", ") + body.body.name;
-  reject(field + ": unknown body '" + name + "' (bodies: " + known + ")");
+  for (std::size_t i = 0; i < std::min(kListed, scene_.bodies.size()); ++i)
+    known += (known.empty() ? "" : ", ") + scene_.bodies[i].body.name;
+  if (scene_.bodies.size() > kListed)
+    known += ", ... (" + std::to_string(scene_.bodies.size()) + " bodies)";
+  const std::string shown = name.size() > 64 ? name.substr(0, 64) + "..." : name;  // a hostile name may be huge
+  reject(field + ": unknown body '" + shown + "' (bodies: " + known + ")");
 }
 
 std::vector<std::size_t> SceneQueries::bodyIndices(const std::vector<std::string>& names,
@@ -94,6 +102,8 @@ SceneState SceneQueries::applyStates(const SceneState& current, const std::vecto
     reject(sizeMismatch("states", "at most " + std::to_string(RequestLimits::kMaxStates) + " states",
                         updates.size()));
   std::unordered_set<std::size_t> seen;
+  std::vector<std::size_t> indices;
+  indices.reserve(updates.size());
   for (std::size_t i = 0; i < updates.size(); ++i)
   {
     const std::string field = "states[" + std::to_string(i) + "]";
@@ -101,10 +111,11 @@ SceneState SceneQueries::applyStates(const SceneState& current, const std::vecto
     if (!seen.insert(index).second)
       reject(field + ".name: body '" + updates[i].name + "' appears more than once");
     requireFinite(updates[i].q.data(), 6, field + ".q (body '" + updates[i].name + "')");
+    indices.push_back(index);
   }
   SceneState next = current;
-  for (const NamedState& update : updates)
-    next[static_cast<std::size_t>(scene_.findBody(update.name))] = update.q;
+  for (std::size_t i = 0; i < updates.size(); ++i)
+    next[indices[i]] = updates[i].q;
   return next;
 }
 

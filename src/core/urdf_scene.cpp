@@ -107,7 +107,10 @@ public:
     {
       CapturedUrdfdomErrors errors;
       model_ = urdf::parseURDF(urdf_xml);
-      if (!model_)
+      // urdfdom may log an error and still return a model in which the bad
+      // element is silently reset or dropped (e.g. mass="nan" becomes 0, a
+      // <box size="nan 1 1"> disappears): any logged error refuses it.
+      if (!model_ || !errors.text().empty())
         throw SceneDescriptionError("robot description: urdfdom rejected it: " +
                                     (errors.text().empty() ? std::string("(no reason given)") : errors.text()));
     }
@@ -136,13 +139,16 @@ public:
     std::vector<std::string> body_links;
     for (const std::string& name : document_order_)
     {
-      if (owner_.at(name).empty())
+      const std::string& owner = owner_.at(name);
+      if (owner.empty())
       {
         if (name != scene.fixed_frame)
           scene.static_links.push_back({ name, fixed_from_root * pose_in_root_.at(name) });
       }
-      else if (owner_.at(name) == name)
+      else if (owner == name)
         body_links.push_back(name);
+      else
+        merged_links_[owner].push_back(name);  // one pass: loading stays linear in the links
     }
     if (body_links.empty())
       throw SceneDescriptionError("robot description: no body (no link is the child of a floating, revolute, "
@@ -176,18 +182,33 @@ public:
 
 private:
   // Pose of every link in the root frame at zero joint values, and its owner:
-  // "" for a static link, else the body link it belongs to.
-  void placeLinks(const urdf::LinkConstSharedPtr& link, const Eigen::Isometry3d& pose, const std::string& owner)
+  // "" for a static link, else the body link it belongs to. Depth first with
+  // an explicit stack: a chain of 10^5 links must not overflow the call stack.
+  void placeLinks(const urdf::LinkConstSharedPtr& root, const Eigen::Isometry3d& root_pose,
+                  const std::string& root_owner)
   {
-    pose_in_root_[link->name] = pose;
-    owner_[link->name] = owner;
-    for (const urdf::JointSharedPtr& joint : link->child_joints)
+    struct Pending
     {
-      const urdf::LinkConstSharedPtr child = model_->getLink(joint->child_link_name);
-      const Eigen::Isometry3d child_pose = pose * toIsometry(joint->parent_to_joint_origin_transform);
-      if (!child_pose.matrix().allFinite())
-        throw SceneDescriptionError("joint '" + joint->name + "': <origin> is not finite");
-      placeLinks(child, child_pose, isFixed(joint) ? owner : child->name);
+      urdf::LinkConstSharedPtr link;
+      Eigen::Isometry3d pose;
+      std::string owner;
+    };
+    std::vector<Pending> stack{ { root, root_pose, root_owner } };
+    while (!stack.empty())
+    {
+      const Pending next = std::move(stack.back());
+      stack.pop_back();
+      pose_in_root_[next.link->name] = next.pose;
+      owner_[next.link->name] = next.owner;
+      // Children pushed in reverse, so that they are visited in order.
+      for (auto joint = next.link->child_joints.rbegin(); joint != next.link->child_joints.rend(); ++joint)
+      {
+        const urdf::LinkConstSharedPtr child = model_->getLink((*joint)->child_link_name);
+        const Eigen::Isometry3d child_pose = next.pose * toIsometry((*joint)->parent_to_joint_origin_transform);
+        if (!child_pose.matrix().allFinite())
+          throw SceneDescriptionError("joint '" + (*joint)->name + "': <origin> is not finite");
+        stack.push_back({ child, child_pose, isFixed(*joint) ? next.owner : child->name });
+      }
     }
   }
 
@@ -327,9 +348,8 @@ private:
     std::vector<std::pair<std::size_t, Eigen::Vector3d>> link_vertices;  // (link slot, position in body link frame)
 
     std::vector<std::string> members{ body_name };
-    for (const std::string& name : document_order_)
-      if (name != body_name && owner_.at(name) == body_name)
-        members.push_back(name);
+    for (const std::string& name : merged_links_[body_name])  // document order
+      members.push_back(name);
 
     for (const std::string& name : members)
     {
@@ -371,7 +391,8 @@ private:
       }
       else if (!geometry_masses.empty())
       {
-        link_masses.emplace_back(slot.pose_in_body_link, combineMassProperties(geometry_masses));
+        link_masses.emplace_back(slot.pose_in_body_link,
+                                 combineMassProperties(geometry_masses, "link '" + name + "' geometry"));
       }
       scene_body.links.push_back(std::move(slot));
     }
@@ -380,7 +401,7 @@ private:
       throw InvalidInertiaError("body '" + body_name + "': no <inertial> in its link or merged links" +
                                 (options_.density ? std::string(" and no geometry to compute one from") :
                                                     std::string(", and parameter density is not set")));
-    const MassProperties composite = combineMassProperties(link_masses);
+    const MassProperties composite = combineMassProperties(link_masses, "body '" + body_name + "'");
     validateMassProperties("body '" + body_name + "'", composite.mass, composite.inertia);
     scene_body.body.mass = composite.mass;
     scene_body.body.com_offset = composite.com;
@@ -409,6 +430,10 @@ private:
     const Eigen::Isometry3d body_in_fixed = fixed_from_root * body_in_root;
     scene_body.initial_state.head<3>() = matrixToRpy(body_in_fixed.linear());
     scene_body.initial_state.tail<3>() = body_in_fixed * composite.com;
+    if (!scene_body.initial_state.allFinite())
+      throw SceneDescriptionError("body '" + body_name +
+                                  "': initial state is not finite (its joint origins and COM offset add up "
+                                  "beyond the range of double)");
     return scene_body;
   }
 
@@ -433,6 +458,7 @@ private:
   std::vector<std::string> document_order_;
   std::unordered_map<std::string, Eigen::Isometry3d> pose_in_root_;
   std::unordered_map<std::string, std::string> owner_;
+  std::unordered_map<std::string, std::vector<std::string>> merged_links_;  ///< body -> merged links, document order
   std::map<std::pair<std::string, std::array<double, 3>>, TriangleMesh> mesh_cache_;
 };
 

@@ -6,6 +6,7 @@
 #include <tf2_msgs/TFMessage.h>
 
 #include "diff_rigid_body/exceptions.h"
+#include "diff_rigid_body/state_file.h"
 
 namespace diff_rigid_body
 {
@@ -57,6 +58,38 @@ bool serve(Response& response, const char* service, Work&& work)
   return true;
 }
 
+// The state to start from: the state file's when it holds a valid state of
+// this scene, else the URDF's (an unusable file is set aside with a warning).
+// The result is saved at once, so that an unwritable ~state_file stops the
+// node at start (StateFileError) instead of refusing every later change.
+SceneState initialState(const SceneQueries& queries, const std::string& state_file)
+{
+  SceneState state = queries.initialState();
+  if (state_file.empty())
+    return state;
+  if (const std::size_t stale = removeStaleTemporaryFiles(state_file))
+    ROS_INFO_STREAM("rigid_body_server: removed " << stale << " temporary file(s) of '" << state_file
+                                                  << "' left by an interrupted save");
+  try
+  {
+    if (std::optional<SceneState> saved = readStateFile(state_file, queries.scene()))
+    {
+      ROS_INFO_STREAM("rigid_body_server: resumed the state saved in '" << state_file << "'");
+      return *saved;
+    }
+    ROS_INFO_STREAM("rigid_body_server: no state file '" << state_file << "' yet; starting from the URDF state");
+  }
+  catch (const StateFileError& e)
+  {
+    const std::string aside = setStateFileAside(state_file);
+    ROS_WARN_STREAM("rigid_body_server: ignoring the state file: " << e.what() << "; starting from the URDF state"
+                                                                   << (aside.empty() ? "" : "; the file was moved to '" +
+                                                                                                aside + "'"));
+  }
+  writeStateFile(state_file, queries.scene(), state);
+  return state;
+}
+
 std::vector<NamedState> toNamedStates(const std::vector<BodyState>& states)
 {
   std::vector<NamedState> named;
@@ -69,7 +102,9 @@ std::vector<NamedState> toNamedStates(const std::vector<BodyState>& states)
 
 RigidBodyServer::RigidBodyServer(ros::NodeHandle& nh, ros::NodeHandle& private_nh, Scene scene,
                                  const ServerSettings& settings)
-  : queries_(std::move(scene)), state_(std::make_shared<const SceneState>(queries_.initialState()))
+  : queries_(std::move(scene))
+  , state_file_(settings.state_file)
+  , state_(std::make_shared<const SceneState>(initialState(queries_, state_file_)))
 {
   (void)nh;
   states_publisher_ = private_nh.advertise<BodyStateArray>("states", 10, /*latch=*/true);
@@ -83,6 +118,15 @@ RigidBodyServer::RigidBodyServer(ros::NodeHandle& nh, ros::NodeHandle& private_n
   services_.push_back(
       private_nh.advertiseService("get_vertex_jacobians", &RigidBodyServer::getVertexJacobians, this));
   services_.push_back(private_nh.advertiseService("backprop", &RigidBodyServer::backprop, this));
+  // --- Benchmarks / reduced transport (bench/): begin
+  services_.push_back(private_nh.advertiseService("get_vertex_jacobians_compact",
+                                                  &RigidBodyServer::getVertexJacobiansCompact, this));
+  if (private_nh.param("benchmark_services", false))
+  {
+    services_.push_back(private_nh.advertiseService("ping", &RigidBodyServer::ping, this));
+    services_.push_back(private_nh.advertiseService("echo", &RigidBodyServer::echo, this));
+  }
+  // --- Benchmarks / reduced transport (bench/): end
   set_states_subscriber_ = private_nh.subscribe("set_states", 100, &RigidBodyServer::onSetStates, this,
                                                 ros::TransportHints().tcpNoDelay());
   timer_ = private_nh.createTimer(ros::Duration(1.0 / settings.publish_rate), &RigidBodyServer::onTimer, this);
@@ -98,6 +142,8 @@ void RigidBodyServer::applyStates(const std::vector<BodyState>& states)
 {
   std::lock_guard<std::mutex> write(write_mutex_);
   auto next = std::make_shared<const SceneState>(queries_.applyStates(*snapshot(), toNamedStates(states)));
+  if (!state_file_.empty())
+    writeStateFile(state_file_, queries_.scene(), *next);  // durable before it is visible or acknowledged
   {
     std::lock_guard<std::mutex> lock(snapshot_mutex_);
     state_ = next;
@@ -224,5 +270,68 @@ void RigidBodyServer::onTimer(const ros::TimerEvent&)
   std::lock_guard<std::mutex> write(write_mutex_);
   publishState(*snapshot(), ros::Time::now());
 }
+
+// --- Benchmarks / reduced transport (bench/): begin
+bool RigidBodyServer::getVertexJacobiansCompact(GetVertexJacobiansCompact::Request& request,
+                                                GetVertexJacobiansCompact::Response& response)
+{
+  return serve(response, "get_vertex_jacobians_compact", [&] {
+    // The checks and messages of get_vertex_jacobians (SceneQueries).
+    const std::size_t index = queries_.bodyIndex(request.body, "body");
+    const RigidBody& body = queries_.body(index);
+    const std::size_t available = static_cast<std::size_t>(body.vertices.cols());
+    const std::size_t count = request.vertices.empty() ? available : request.vertices.size();
+    if (count > RequestLimits::kMaxVertices)
+      throw InvalidArgumentError("vertices: expected at most " + std::to_string(RequestLimits::kMaxVertices) +
+                                 " vertices, got " + std::to_string(count) + " values");
+    for (std::size_t i = 0; i < request.vertices.size(); ++i)
+      if (request.vertices[i] >= available)
+        throw InvalidArgumentError("vertices[" + std::to_string(i) + "]: index " +
+                                   std::to_string(request.vertices[i]) + " out of range for body '" + body.name +
+                                   "' with " + std::to_string(available) + " vertices");
+    Vector6<double> q = (*snapshot())[index];
+    if (!request.q.empty())
+    {
+      if (request.q.size() != 6)
+        throw InvalidArgumentError("q: expected 6 values (or empty for the current state), got " +
+                                   std::to_string(request.q.size()) + " values");
+      requireFinite(request.q.data(), 6, "q");
+      q = Eigen::Map<const Vector6<double>>(request.q.data());
+    }
+    const BodyPose<double> pose(q);
+    auto fill = [&](auto& positions, auto& jacobians) {
+      positions.resize(3 * count);
+      if (!request.positions_only)
+        jacobians.resize(9 * count);
+      vertexPositionsAndRotationJacobians(pose, body.vertices, request.vertices, positions.data(),
+                                          request.positions_only ? nullptr : jacobians.data());
+      // Finite inputs can still overflow (a far position, or float32).
+      for (const auto* field : { &positions, &jacobians })
+        for (const auto value : *field)
+          if (!std::isfinite(value))
+            throw InvalidArgumentError("q: results of body '" + body.name + "' overflow" +
+                                       (request.single_precision ? " float32" : ""));
+    };
+    if (request.single_precision)
+      fill(response.positions_f32, response.rotation_jacobians_f32);
+    else
+      fill(response.positions, response.rotation_jacobians);
+  });
+}
+
+bool RigidBodyServer::ping(Ping::Request&, Ping::Response& response)
+{
+  return serve(response, "ping", [] {});
+}
+
+bool RigidBodyServer::echo(Echo::Request& request, Echo::Response& response)
+{
+  return serve(response, "echo", [&] {
+    if (request.response_size > 21 * RequestLimits::kMaxVertices)
+      throw InvalidArgumentError("response_size: at most " + std::to_string(21 * RequestLimits::kMaxVertices));
+    response.data.resize(request.response_size);
+  });
+}
+// --- Benchmarks / reduced transport (bench/): end
 
 }  // namespace diff_rigid_body

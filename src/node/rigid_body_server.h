@@ -8,6 +8,10 @@
 // Readers take the current pointer under a short lock and compute without
 // locks, so every answer comes from one consistent state; writers are
 // serialised by a second mutex and swap in a new snapshot.
+//
+// Durable state (~state_file): a writer saves the new state (temp file,
+// fsync, rename, fsync of the folder) before it swaps the snapshot in, so an
+// acknowledged change survives a crash; a failed save refuses the change.
 #pragma once
 
 #include <memory>
@@ -25,6 +29,10 @@
 #include <diff_rigid_body/GetState.h>
 #include <diff_rigid_body/GetVertexJacobians.h>
 #include <diff_rigid_body/SetState.h>
+// Benchmarks and reduced transport (bench/):
+#include <diff_rigid_body/Echo.h>
+#include <diff_rigid_body/GetVertexJacobiansCompact.h>
+#include <diff_rigid_body/Ping.h>
 
 #include "diff_rigid_body/scene_queries.h"
 
@@ -34,6 +42,9 @@ namespace diff_rigid_body
 struct ServerSettings
 {
   double publish_rate = 50.0;  ///< [Hz] tf and ~states, clamped to [0.1, 1000]
+  /// ~state_file: "" (off), or a file that every accepted state change is
+  /// written to durably before it is acknowledged, and resumed from on start.
+  std::string state_file;
 };
 
 class RigidBodyServer
@@ -57,10 +68,16 @@ private:
   bool getMassMatrix(GetMassMatrix::Request& request, GetMassMatrix::Response& response);
   bool getVertexJacobians(GetVertexJacobians::Request& request, GetVertexJacobians::Response& response);
   bool backprop(Backprop::Request& request, Backprop::Response& response);
+  // Reduced transport (always on) and, with ~benchmark_services, ~ping / ~echo (bench/).
+  bool getVertexJacobiansCompact(GetVertexJacobiansCompact::Request& request,
+                                 GetVertexJacobiansCompact::Response& response);
+  bool ping(Ping::Request& request, Ping::Response& response);
+  bool echo(Echo::Request& request, Echo::Response& response);
   void onSetStates(const BodyStateArray::ConstPtr& message);
   void onTimer(const ros::TimerEvent& event);
 
   const SceneQueries queries_;
+  const std::string state_file_;       ///< "" when durable state is off
   mutable std::mutex snapshot_mutex_;  ///< guards state_ (the pointer, not the data)
   std::mutex write_mutex_;             ///< serialises state changes and their publication
   StatePtr state_;

@@ -2,6 +2,7 @@
 // quantities. An unusable description is logged and the node exits with 1;
 // it never half-starts.
 #include <cmath>
+#include <memory>
 #include <sstream>
 
 #include <ros/package.h>
@@ -62,8 +63,12 @@ drb::Scene loadScene(const ros::NodeHandle& nh, const ros::NodeHandle& private_n
     return drb::loadSceneFromUrdfFile(urdf_path, options);
   std::string urdf_xml;
   if (!nh.getParam("robot_description", urdf_xml))
+  {
+    if (nh.hasParam("robot_description"))
+      throw drb::SceneDescriptionError("parameter robot_description: must be a string (URDF XML)");
     throw drb::SceneDescriptionError("no robot description: set the parameter '" +
                                      nh.resolveName("robot_description") + "' or ~urdf_path");
+  }
   return drb::loadSceneFromUrdf(urdf_xml, options);
 }
 }  // namespace
@@ -80,6 +85,7 @@ int main(int argc, char** argv)
   if (settings.publish_rate != rate)
     ROS_WARN("~publish_rate %g Hz is out of range; using %g Hz", rate, settings.publish_rate);
   const int threads = std::clamp(private_nh.param("threads", 4), 1, 64);
+  settings.state_file = private_nh.param<std::string>("state_file", "");
 
   drb::Scene scene;
   try
@@ -100,7 +106,16 @@ int main(int argc, char** argv)
   ROS_INFO_STREAM("rigid_body_server: serving " << scene.bodies.size() << " bodies in '" << scene.fixed_frame
                                                 << "':" << summary.str());
 
-  drb::RigidBodyServer server(nh, private_nh, std::move(scene), settings);
+  std::unique_ptr<drb::RigidBodyServer> server;
+  try
+  {
+    server = std::make_unique<drb::RigidBodyServer>(nh, private_nh, std::move(scene), settings);
+  }
+  catch (const drb::Error& e)  // e.g. an unwritable ~state_file
+  {
+    ROS_FATAL_STREAM("rigid_body_server: cannot start: " << e.what());
+    return 1;
+  }
   ros::MultiThreadedSpinner spinner(static_cast<std::uint32_t>(threads));
   spinner.spin();
   return 0;

@@ -343,6 +343,88 @@ TEST(MassMatrix, FiniteForExtremeMassesAndThinRods)
     }
 }
 
+// massMatrixBatch: blocks of kSinCosLanes states use the vectorised sinCos,
+// the tail and other scalars std::sin/cos; a block holding a non-finite or
+// |angle| >= kSinCosFastLimit falls back to std::sin/cos. Each M_k must
+// match the 256-bit reference to the same ulp bound as massMatrix (measured
+// 4.4 ulp worst in a 200,000-state sweep for both), cos_theta must be within
+// the documented absolute error of sinCos, and a bad state must not spoil
+// the others in its block.
+TEST(MassMatrix, BatchMatchesMpfrAndSingleStateKernel)
+{
+  mpreal::set_default_prec(256);
+  Random rng(605);
+  // cos theta: sinCos's documented absolute error (~2 ulp of 1); measured 0.7 eps.
+  constexpr double kCosAbsTol = 2 * kEps;
+  MaxTracker ulps, cos_err;
+  const auto bodies = hardBodies(rng);
+  const std::vector<double> thetas = gimbalLockThetas();
+  for (const std::size_t stride : { std::size_t(6), std::size_t(9) })
+    for (const std::size_t count : { std::size_t(0), std::size_t(1), std::size_t(7), std::size_t(8),
+                                     std::size_t(9), std::size_t(203) })
+    {
+      const Body b = count == 203 ? Body{ 1.5, rng.inertia(rng.logUniform(1e-3, 1e3)), "random" }
+                                  : bodies[rng.integer(0, static_cast<int>(bodies.size()) - 1)];
+      std::vector<double> q(stride * count + 1, 0.0);
+      for (std::size_t k = 0; k < count; ++k)
+      {
+        Vector6<double> qk = rng.state();
+        if (k % 3 == 1)
+          qk[1] = thetas[k % thetas.size()];
+        if (k % 5 == 2)
+          qk[0] = rng.uniform(-1.5e6, 1.5e6);  // large, still on the fast path
+        if (k == 100)
+          qk[1] = 2e6;  // beyond kSinCosFastLimit: this block falls back
+        for (int j = 0; j < 6; ++j)
+          q[stride * k + j] = qk[j];
+        for (std::size_t j = 6; j < stride; ++j)
+          q[stride * k + j] = std::numeric_limits<double>::quiet_NaN();  // padding is never read
+      }
+      std::vector<double> M(36 * count + 1, -999.0), cos_theta(count + 1, -999.0);
+      drb::massMatrixBatch(q.data(), count, stride, b.mass, b.I, M.data(), cos_theta.data());
+      ASSERT_EQ(M[36 * count], -999.0);
+      ASSERT_EQ(cos_theta[count], -999.0);
+      for (std::size_t k = 0; k < count; ++k)
+      {
+        const Vector6<double> qk = Eigen::Map<const Vector6<double>>(q.data() + stride * k);
+        const Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>> Mk(M.data() + 36 * k);
+        const MatrixMp6 M_ref = drb::massMatrix(VectorMp6(qk.cast<mpreal>()), mpreal(b.mass), MatrixMp3(b.I.cast<mpreal>()));
+        const mpreal err =
+            (Matrix3<double>(Mk.topLeftCorner<3, 3>()).cast<mpreal>() - M_ref.topLeftCorner<3, 3>()).cwiseAbs().maxCoeff();
+        const double e = err.toDouble() / ulp(angularScale(toDouble(M_ref)));
+        ulps.update(e);
+        ASSERT_LE(e, kMpfrUlps) << "state " << k << " of " << count << ", stride " << stride << ", q = " << qk.transpose();
+        expectExactTranslationBlock(Matrix6<double>(Mk), b.mass);
+        const double e_cos = std::abs(cos_theta[k] - mpfr::cos(mpreal(qk[1])).toDouble());
+        cos_err.update(e_cos);
+        ASSERT_LE(e_cos, kCosAbsTol) << "theta = " << qk[1];
+      }
+    }
+  // One NaN state in a block: NaN there, correct values for its neighbours.
+  std::vector<double> q(6 * 8);
+  std::vector<Vector6<double>> states;
+  for (int k = 0; k < 8; ++k)
+  {
+    states.push_back(rng.state());
+    Eigen::Map<Vector6<double>>(q.data() + 6 * k) = states.back();
+  }
+  q[6 * 3 + 1] = std::numeric_limits<double>::quiet_NaN();
+  const Body b{ 2.0, rng.inertia(), "random" };
+  std::vector<double> M(36 * 8), cos_theta(8);
+  drb::massMatrixBatch(q.data(), 8, 6, b.mass, b.I, M.data(), cos_theta.data());
+  EXPECT_TRUE(std::isnan(cos_theta[3]));
+  for (int k = 0; k < 8; ++k)
+    if (k != 3)
+    {
+      const Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>> Mk(M.data() + 36 * k);
+      EXPECT_LE(maxAbs(Matrix6<double>(Mk) - kernelM(states[k], b)) / angularScale(kernelM(states[k], b)),
+                2 * kMpfrUlps * kEps)
+          << "state " << k;
+    }
+  std::printf("[measured] massMatrixBatch vs 256-bit MPFR: %.3g ulp; cos theta %.3g eps absolute\n", ulps.value,
+              cos_err.value / kEps);
+}
+
 // ---------------------------------------------------------------------------
 // dM/dq.
 

@@ -16,6 +16,7 @@
 // the block's Frobenius norm is >= |p0|, so the largest entry is >= |p0|/sqrt(6):
 // "relative to |p0|" is "relative to the largest entry" within a factor 2.5.
 // The translation block must be exactly I3.
+#include <algorithm>
 #include <cfloat>
 #include <cmath>
 #include <cstdint>
@@ -369,6 +370,158 @@ TEST(VertexJacobian, BatchLayoutMatchesOracle)
   }
 }
 
+// The double batch kernel has SIMD paths: pairs of vertices (adjacent
+// vertices loaded together, others lane by lane), an odd last vertex, and
+// streaming stores for outputs >= kStreamingStoreBytes into 16-byte aligned
+// buffers. Every count, selection shape and alignment must give the oracle's
+// values and, as documented, the same bits as the single-vertex kernels.
+namespace
+{
+/// Checks `count` outputs of the batch kernel against vertexJacobian /
+/// vertexPosition (bits, or 4 eps where FMA contraction may differ) and, for
+/// every `oracle_every`-th vertex, against the long-form oracle.
+void expectBatchMatches(const Vector6<double>& q, const drb::Matrix3X<double>& vertices,
+                        const std::vector<std::uint32_t>& indices, const double* positions, const double* jacobians,
+                        std::size_t oracle_every = 1)
+{
+  const drb::BodyPose<double> pose(q);
+  const std::size_t count = indices.empty() ? static_cast<std::size_t>(vertices.cols()) : indices.size();
+#if defined(__FMA__)
+  const double same_tol = 4 * kEps;  // contraction may round differently per path
+#else
+  const double same_tol = 0.0;  // documented: the same bits on every path
+#endif
+  for (std::size_t n = 0; n < count; ++n)
+  {
+    const Vector3<double> p0 = vertices.col(indices.empty() ? n : indices[n]);
+    const Matrix36<double> J = drb::vertexJacobian(pose, p0);
+    const Vector3<double> p = drb::vertexPosition(pose, p0);
+    const double scale = std::max(p0.norm(), 1.0);
+    for (int i = 0; i < 3; ++i)
+    {
+      if (positions)
+      {
+        ASSERT_LE(std::abs(positions[3 * n + i] - p[i]), same_tol * (p0.norm() + q.tail<3>().norm()))
+            << "vertex " << n << " of " << count << ", row " << i;
+      }
+      for (int j = 0; j < 6; ++j)
+        ASSERT_LE(std::abs(jacobians[18 * n + 6 * i + j] - J(i, j)), same_tol * scale)
+            << "vertex " << n << " of " << count << ", entry (" << i << "," << j << ")";
+    }
+    if (n % oracle_every == 0)
+    {
+      const Matrix36<double> J_ref = refJacobian(q, p0);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 6; ++j)
+          ASSERT_LE(std::abs(jacobians[18 * n + 6 * i + j] - J_ref(i, j)), kLongFormTol * scale)
+              << "vertex " << n << " entry (" << i << "," << j << ")";
+    }
+  }
+}
+}  // namespace
+
+TEST(VertexJacobian, BatchEveryCountSelectionAndAlignment)
+{
+  Random rng(207);
+  const Vector6<double> q = rng.state();
+  const drb::BodyPose<double> pose(q);
+  const drb::Matrix3X<double> pool = randomVertices(rng, 40, 3.0);
+  std::vector<std::pair<drb::Matrix3X<double>, std::vector<std::uint32_t>>> cases;
+  for (int count = 0; count <= 11; ++count)
+    cases.push_back({ drb::Matrix3X<double>(pool.leftCols(count)), {} });  // all, even and odd counts
+  for (const std::vector<std::uint32_t>& indices :
+       { std::vector<std::uint32_t>{ 4 }, { 4, 5 }, { 4, 5, 6 }, { 9, 8, 7, 6, 5 }, { 3, 3 }, { 3, 3, 3 },
+         { 0, 39, 1, 38, 2, 37, 20 }, { 39, 39, 0, 1, 2, 3, 10, 11 } })
+    cases.push_back({ pool, indices });
+  for (const auto& [vertices, indices] : cases)
+  {
+    const std::size_t count = indices.empty() ? static_cast<std::size_t>(vertices.cols()) : indices.size();
+    for (const std::size_t offset : { 0, 1 })  // 16-byte aligned, and not
+      for (const bool with_positions : { true, false })
+      {
+        std::vector<double> P(3 * count + 2, -999.0), J(18 * count + 2, -999.0);
+        double* positions = with_positions ? P.data() + offset : nullptr;
+        drb::vertexPositionsAndJacobians(pose, vertices, indices, positions, J.data() + offset);
+        expectBatchMatches(q, vertices, indices, positions, J.data() + offset);
+        // Nothing written outside the outputs.
+        ASSERT_EQ(J[offset ? 0 : 18 * count], -999.0);
+        ASSERT_EQ(J[18 * count + 1], -999.0);
+        ASSERT_EQ(P[3 * count + 1], -999.0);
+        if (!with_positions)
+        {
+          ASSERT_EQ(P[offset], -999.0);
+        }
+      }
+    // Positions only.
+    std::vector<double> P(3 * count);
+    drb::vertexPositionsAndJacobians(pose, vertices, indices, P.data(), static_cast<double*>(nullptr));
+    for (std::size_t n = 0; n < count; ++n)
+    {
+      const Vector3<double> p0 = vertices.col(indices.empty() ? n : indices[n]);
+      for (int i = 0; i < 3; ++i)
+        ASSERT_NEAR(P[3 * n + i], refPosition(q, p0)[i], kPositionTol * (p0.norm() + q.tail<3>().norm()));
+    }
+  }
+}
+
+TEST(VertexJacobian, BatchStreamingPathForLargeOutputs)
+{
+  Random rng(208);
+  const Vector6<double> q = rng.state();
+  // Just past the streaming threshold, an odd count that is not a multiple
+  // of the 16-vertex streaming block.
+  const std::size_t count = drb::kStreamingStoreBytes / (18 * sizeof(double)) + 37;
+  drb::Matrix3X<double> vertices(3, static_cast<Eigen::Index>(count));
+  for (Eigen::Index i = 0; i < vertices.cols(); ++i)
+    vertices.col(i) = rng.vector(2.0);
+  std::vector<double> P(3 * count), J(18 * count);
+  ASSERT_EQ(reinterpret_cast<std::uintptr_t>(J.data()) % 16, 0u);
+  ASSERT_EQ(reinterpret_cast<std::uintptr_t>(P.data()) % 16, 0u);
+  drb::vertexPositionsAndJacobians(drb::BodyPose<double>(q), vertices, {}, P.data(), J.data());
+  expectBatchMatches(q, vertices, {}, P.data(), J.data(), 97);
+  // Without positions, and through an index list.
+  std::vector<std::uint32_t> indices(count);
+  for (std::size_t n = 0; n < count; ++n)
+    indices[n] = static_cast<std::uint32_t>((n * 7919) % count);
+  std::fill(J.begin(), J.end(), -999.0);
+  drb::vertexPositionsAndJacobians(drb::BodyPose<double>(q), vertices, indices, static_cast<double*>(nullptr),
+                                   J.data());
+  expectBatchMatches(q, vertices, indices, nullptr, J.data(), 97);
+}
+
+// The reduced transport writes only the rotation block (3x3 row-major per
+// vertex), equal to the full kernel's before the conversion to Out.
+TEST(VertexJacobian, RotationJacobiansMatchFullKernel)
+{
+  Random rng(209);
+  for (int s = 0; s < 20; ++s)
+  {
+    const Vector6<double> q = rng.state();
+    const drb::BodyPose<double> pose(q);
+    const drb::Matrix3X<double> vertices = randomVertices(rng, 13, rng.logUniform(1e-6, 1e4));
+    for (const std::vector<std::uint32_t>& indices : { std::vector<std::uint32_t>{}, { 12, 0, 5, 5 } })
+    {
+      const std::size_t count = indices.empty() ? 13 : indices.size();
+      std::vector<double> P(3 * count), J(18 * count), Pd(3 * count), Jd(9 * count);
+      std::vector<float> Pf(3 * count), Jf(9 * count);
+      drb::vertexPositionsAndJacobians(pose, vertices, indices, P.data(), J.data());
+      drb::vertexPositionsAndRotationJacobians(pose, vertices, indices, Pd.data(), Jd.data());
+      drb::vertexPositionsAndRotationJacobians(pose, vertices, indices, Pf.data(), Jf.data());
+      for (std::size_t n = 0; n < count; ++n)
+        for (int i = 0; i < 3; ++i)
+        {
+          ASSERT_EQ(Pd[3 * n + i], P[3 * n + i]);
+          ASSERT_EQ(Pf[3 * n + i], static_cast<float>(P[3 * n + i]));
+          for (int k = 0; k < 3; ++k)
+          {
+            ASSERT_EQ(Jd[9 * n + 3 * i + k], J[18 * n + 6 * i + k]) << "vertex " << n;
+            ASSERT_EQ(Jf[9 * n + 3 * i + k], static_cast<float>(J[18 * n + 6 * i + k])) << "vertex " << n;
+          }
+        }
+    }
+  }
+}
+
 // ---------------------------------------------------------------------------
 // Backprop.
 
@@ -451,6 +604,32 @@ TEST(Backprop, HardCases)
       ASSERT_LE(e, kBackpropTol) << "q = " << q.transpose() << ", scale " << scale;
     }
   std::printf("[measured] backprop hard cases: %.3g eps\n", err.value / kEps);
+}
+
+// The double backprop sums vertex pairs in SIMD lanes with an odd last
+// vertex: every count and selection length must match J^T g.
+TEST(Backprop, EveryCountAndSelectionLength)
+{
+  Random rng(304);
+  MaxTracker err;
+  for (int count = 1; count <= 17; ++count)
+    for (int rep = 0; rep < 5; ++rep)
+    {
+      const Vector6<double> q = rng.state();
+      const drb::Matrix3X<double> vertices = randomVertices(rng, count, rng.logUniform(1e-3, 1e3));
+      const BackpropCheck all = checkBackprop(q, vertices, {}, randomGradients(rng, count));
+      std::vector<std::uint32_t> indices(static_cast<std::size_t>(rng.integer(1, 9)));
+      for (auto& index : indices)
+        index = static_cast<std::uint32_t>(rng.integer(0, count - 1));
+      const BackpropCheck subset = checkBackprop(q, vertices, indices, randomGradients(rng, indices.size()));
+      for (const BackpropCheck& r : { all, subset })
+      {
+        const double e = std::max({ r.rotation_error, r.translation_error, r.loss_cs_error });
+        err.update(e);
+        ASSERT_LE(e, kBackpropTol) << count << " vertices, q = " << q.transpose();
+      }
+    }
+  std::printf("[measured] backprop, 1..17 vertices and subsets: %.3g eps\n", err.value / kEps);
 }
 
 TEST(Backprop, EmptySelectionGivesZero)

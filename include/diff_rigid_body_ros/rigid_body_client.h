@@ -1,0 +1,271 @@
+// A roscpp client of rigid_body_server returning Eigen types.
+//
+// Header only. Persistent ServiceClients (one TCP connection per service,
+// reopened once if it drops, e.g. when the node restarts). A service that
+// answers success=false throws diff_rigid_body_ros::ServiceError carrying the
+// node's message; a service that cannot be reached throws
+// diff_rigid_body_ros::ConnectionError. Not thread-safe (persistent clients
+// are not): use one RigidBodyClient per thread.
+//
+// This is the ROS layer: it lives outside include/diff_rigid_body/, the
+// ROS-free core.
+//
+// q = (phi, theta, psi [rad], tx, ty, tz [m]); matrices in q order.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+#include <ros/ros.h>
+
+#include <diff_rigid_body/Backprop.h>
+#include <diff_rigid_body/BodyState.h>
+#include <diff_rigid_body/GetBodies.h>
+#include <diff_rigid_body/GetMassMatrix.h>
+#include <diff_rigid_body/GetState.h>
+#include <diff_rigid_body/GetVertexJacobians.h>
+#include <diff_rigid_body/SetState.h>
+
+namespace diff_rigid_body_ros
+{
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+/// Stacked vertex Jacobians: rows 3v..3v+2 are J_v = dp_v/dq (3x6).
+using StackedJacobians = Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>;
+
+/// A service answered success=false. message() is the node's explanation
+/// (it names the body, index or field); the node's state is unchanged.
+class ServiceError : public std::runtime_error
+{
+public:
+  ServiceError(const std::string& service, const std::string& message)
+    : std::runtime_error(service + ": " + message), service_(service), message_(message)
+  {
+  }
+  const std::string& service() const { return service_; }
+  const std::string& message() const { return message_; }
+
+private:
+  std::string service_;
+  std::string message_;
+};
+
+/// A service could not be reached (not advertised within the timeout, or the
+/// call failed again after reconnecting).
+class ConnectionError : public std::runtime_error
+{
+public:
+  using std::runtime_error::runtime_error;
+};
+
+/// get_bodies.
+struct Bodies
+{
+  std::string fixed_frame;
+  std::vector<std::string> names;
+  std::vector<double> masses;                     ///< [kg]
+  std::vector<Eigen::Matrix3d> inertias;          ///< [kg m^2] about the COM, body axes
+  std::vector<Eigen::Vector3d> com_offsets;       ///< [m] the COM in the link frame
+  std::vector<std::uint32_t> vertex_counts;
+};
+
+/// get_mass_matrix: K configurations of n bodies.
+struct MassMatrices
+{
+  std::vector<std::string> bodies;             ///< the n bodies, in answer order
+  std::size_t configurations = 0;              ///< K
+  std::vector<Matrix6d> M;                     ///< K*n matrices; configuration k, body i at k*n + i
+  std::vector<std::array<Matrix6d, 6>> dM;     ///< with derivatives: dM[k*n + i][j] = dM/dq_j
+  std::vector<double> cos_theta;               ///< gimbal-lock diagnostic, one per matrix
+
+  const Matrix6d& at(std::size_t k, std::size_t i) const { return M.at(k * bodies.size() + i); }
+};
+
+/// get_vertex_jacobians.
+struct VertexJacobians
+{
+  Eigen::Matrix3Xd positions;  ///< [m] column v = vertex v in the fixed frame
+  StackedJacobians J;          ///< 3N x 6; J.middleRows<3>(3 * v) = dp_v/dq
+
+  Eigen::Matrix<double, 3, 6> jacobian(Eigen::Index v) const { return J.middleRows<3>(3 * v); }
+};
+
+class RigidBodyClient
+{
+public:
+  /// \param server   the node's name, resolved in nh's namespace (default "rigid_body_server").
+  /// \param timeout  how long to wait for a service when connecting or reconnecting.
+  explicit RigidBodyClient(const ros::NodeHandle& nh = ros::NodeHandle(),
+                           const std::string& server = "rigid_body_server",
+                           ros::Duration timeout = ros::Duration(30.0))
+    : nh_(nh), server_(nh.resolveName(server)), timeout_(timeout)
+  {
+  }
+
+  Bodies bodies()
+  {
+    diff_rigid_body::GetBodies srv;
+    call(get_bodies_, "get_bodies", srv);
+    Bodies out;
+    out.fixed_frame = srv.response.fixed_frame;
+    out.names = srv.response.names;
+    out.masses = srv.response.masses;
+    out.vertex_counts = srv.response.vertex_counts;
+    for (std::size_t i = 0; i < out.names.size(); ++i)
+    {
+      out.inertias.push_back(Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(
+          srv.response.inertias.data() + 9 * i));
+      out.com_offsets.push_back(Eigen::Map<const Eigen::Vector3d>(srv.response.com_offsets.data() + 3 * i));
+    }
+    return out;
+  }
+
+  /// States of `bodies` (empty = all), in the node's order.
+  std::vector<std::pair<std::string, Vector6d>> getState(const std::vector<std::string>& bodies = {})
+  {
+    diff_rigid_body::GetState srv;
+    srv.request.bodies = bodies;
+    call(get_state_, "get_state", srv);
+    std::vector<std::pair<std::string, Vector6d>> out;
+    for (const auto& state : srv.response.states)
+      out.emplace_back(state.name, Eigen::Map<const Vector6d>(state.q.data()));
+    return out;
+  }
+
+  /// All or nothing.
+  void setState(const std::vector<std::pair<std::string, Vector6d>>& states)
+  {
+    diff_rigid_body::SetState srv;
+    for (const auto& named : states)
+    {
+      diff_rigid_body::BodyState state;
+      state.name = named.first;
+      Eigen::Map<Vector6d>(state.q.data()) = named.second;
+      srv.request.states.push_back(state);
+    }
+    call(set_state_, "set_state", srv);
+  }
+  void setState(const std::string& body, const Vector6d& q) { setState({ { body, q } }); }
+
+  /// M(q) of `bodies` (empty = all). `q`: empty = the current state, else K
+  /// configurations of the n bodies, K*6*n values (configuration k, body i at
+  /// (k*n + i)*6). The node's state is not changed.
+  MassMatrices massMatrices(const std::vector<std::string>& bodies = {}, const std::vector<double>& q = {},
+                            bool derivatives = false)
+  {
+    diff_rigid_body::GetMassMatrix srv;
+    srv.request.bodies = bodies;
+    srv.request.q = q;
+    srv.request.derivatives = derivatives;
+    call(get_mass_matrix_, "get_mass_matrix", srv);
+    const auto& r = srv.response;
+    MassMatrices out;
+    out.bodies = r.bodies;
+    const std::size_t count = r.mass_matrices.size() / 36;
+    out.configurations = out.bodies.empty() ? 0 : count / out.bodies.size();
+    out.M.reserve(count);
+    for (std::size_t m = 0; m < count; ++m)
+      out.M.push_back(Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>>(r.mass_matrices.data() + 36 * m));
+    if (derivatives)
+    {
+      out.dM.resize(count);
+      for (std::size_t m = 0; m < count; ++m)
+        for (int j = 0; j < 6; ++j)
+          out.dM[m][j] =
+              Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>>(r.derivatives.data() + 216 * m + 36 * j);
+    }
+    out.cos_theta = r.cos_theta;
+    return out;
+  }
+
+  /// M of one body at q (one configuration).
+  Matrix6d massMatrix(const std::string& body, const Vector6d& q)
+  {
+    return massMatrices({ body }, std::vector<double>(q.data(), q.data() + 6)).M.at(0);
+  }
+
+  /// Positions and J = dp/dq of `body`'s `vertices` (empty = all) at `q`
+  /// (nullptr = the current state).
+  VertexJacobians vertexJacobians(const std::string& body, const Vector6d* q = nullptr,
+                                  const std::vector<std::uint32_t>& vertices = {})
+  {
+    diff_rigid_body::GetVertexJacobians srv;
+    srv.request.body = body;
+    srv.request.vertices = vertices;
+    if (q)
+      srv.request.q.assign(q->data(), q->data() + 6);
+    call(get_vertex_jacobians_, "get_vertex_jacobians", srv);
+    const auto& r = srv.response;
+    const Eigen::Index n = static_cast<Eigen::Index>(r.positions.size() / 3);
+    VertexJacobians out;
+    out.positions = Eigen::Map<const Eigen::Matrix3Xd>(r.positions.data(), 3, n);
+    out.J = Eigen::Map<const StackedJacobians>(r.jacobians.data(), 3 * n, 6);
+    return out;
+  }
+  VertexJacobians vertexJacobians(const std::string& body, const Vector6d& q,
+                                  const std::vector<std::uint32_t>& vertices = {})
+  {
+    return vertexJacobians(body, &q, vertices);
+  }
+
+  /// dL/dq from dL/dp (3 x N, column v for vertex v) of `body`'s `vertices`
+  /// (empty = all) at `q` (nullptr = the current state). J is never formed.
+  Vector6d backprop(const std::string& body, const Eigen::Matrix3Xd& gradients, const Vector6d* q = nullptr,
+                    const std::vector<std::uint32_t>& vertices = {})
+  {
+    diff_rigid_body::Backprop srv;
+    srv.request.body = body;
+    srv.request.vertices = vertices;
+    srv.request.gradients.assign(gradients.data(), gradients.data() + gradients.size());
+    if (q)
+      srv.request.q.assign(q->data(), q->data() + 6);
+    call(backprop_, "backprop", srv);
+    return Eigen::Map<const Vector6d>(srv.response.gradient.data());
+  }
+  Vector6d backprop(const std::string& body, const Eigen::Matrix3Xd& gradients, const Vector6d& q,
+                    const std::vector<std::uint32_t>& vertices = {})
+  {
+    return backprop(body, gradients, &q, vertices);
+  }
+
+  const std::string& server() const { return server_; }
+
+private:
+  template <typename Service>
+  void connect(ros::ServiceClient& client, const std::string& service)
+  {
+    const std::string name = server_ + "/" + service;
+    if (!ros::service::waitForService(name, timeout_))
+      throw ConnectionError("service " + name + " is not advertised (waited " + std::to_string(timeout_.toSec()) +
+                            " s)");
+    client = nh_.serviceClient<Service>(name, /*persistent=*/true);
+  }
+
+  /// Calls over the persistent connection; reconnects once if it dropped.
+  template <typename Service>
+  void call(ros::ServiceClient& client, const std::string& service, Service& srv)
+  {
+    if (!client || !client.isValid())
+      connect<Service>(client, service);
+    if (!client.call(srv))
+    {
+      connect<Service>(client, service);
+      if (!client.call(srv))
+        throw ConnectionError("service " + server_ + "/" + service + " failed after reconnecting");
+    }
+    if (!srv.response.success)
+      throw ServiceError(server_ + "/" + service, srv.response.message);
+  }
+
+  ros::NodeHandle nh_;
+  std::string server_;
+  ros::Duration timeout_;
+  ros::ServiceClient get_bodies_, set_state_, get_state_, get_mass_matrix_, get_vertex_jacobians_, backprop_;
+};
+
+}  // namespace diff_rigid_body_ros

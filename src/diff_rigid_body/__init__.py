@@ -1,0 +1,19 @@
+"""Python clients of rigid_body_server.
+
+``diff_rigid_body.client``: :class:`RigidBodyClient` (numpy arrays over
+persistent service connections) and :class:`DiffRigidBodyError`.
+``diff_rigid_body.pose_fitting`` and ``diff_rigid_body.trajectory_energy``:
+the example optimisers run by ``nodes/demo_client.py``.
+
+The generated ``diff_rigid_body.msg`` and ``diff_rigid_body.srv`` packages sit
+beside these modules (catkin merges them).
+"""
+# Imported lazily so that ``import diff_rigid_body.msg`` does not need rospy's
+# service machinery or numpy.
+
+
+def __getattr__(name):
+    if name in ('RigidBodyClient', 'DiffRigidBodyError', 'Bodies', 'MassMatrices'):
+        from diff_rigid_body import client
+        return getattr(client, name)
+    raise AttributeError("module 'diff_rigid_body' has no attribute %r" % name)

@@ -1,0 +1,212 @@
+"""A numpy client for rigid_body_server.
+
+Wraps the node's six services with persistent connections and returns numpy
+arrays. Response arrays are deserialised straight from the wire with
+``np.frombuffer`` (``rospy.numpy_msg``): no per-element Python loop. The
+arrays returned are read-only views on the received buffer; ``.copy()`` one
+to modify it.
+
+Shapes (n bodies, N vertices, K configurations; q = (phi, theta, psi, tx, ty, tz)):
+
+==========================  ===============================================
+``mass_matrix(...).M``      (n, 6, 6), or (K, n, 6, 6) for a batched ``q``
+``mass_matrix(...).dM``     (n, 6, 6, 6): ``dM[i, j]`` = dM/dq_j of body i
+                            (a 6x6 matrix); (K, n, 6, 6, 6) when batched
+``vertex_jacobians(...)``   positions (N, 3) [m], J (N, 3, 6): ``J[v]`` = dp_v/dq
+``backprop(...)``           dL/dq, (6,)
+``get_state()``             dict name -> q (6,)
+==========================  ===============================================
+
+A service that answers ``success: False`` raises :class:`DiffRigidBodyError`
+with the node's message. If a persistent connection drops (the node was
+restarted), the call reconnects once, waiting up to ``timeout`` for the
+service, and is retried; every service is idempotent, so a retry is safe.
+
+A client is not thread-safe (persistent connections are not): use one per
+thread.
+"""
+import collections
+
+import numpy as np
+import rospy
+from rospy.numpy_msg import numpy_msg
+
+from diff_rigid_body.msg import BodyState
+from diff_rigid_body.srv import Backprop, GetBodies, GetMassMatrix, GetState, GetVertexJacobians, SetState
+
+__all__ = ['DiffRigidBodyError', 'RigidBodyClient', 'Bodies', 'MassMatrices']
+
+
+class DiffRigidBodyError(RuntimeError):
+    """A service of rigid_body_server refused a request (``success: False``).
+
+    ``service`` is the service's name, ``message`` the node's explanation (it
+    names the body, index or field at fault). The node's state is unchanged.
+    """
+
+    def __init__(self, service, message):
+        super().__init__('%s: %s' % (service, message))
+        self.service = service
+        self.message = message
+
+
+#: ``get_bodies``: fixed_frame (str), names (list of str), masses (n,) [kg],
+#: inertias (n, 3, 3) [kg m^2] about the COM in body axes, com_offsets (n, 3) [m]
+#: in the link frame, vertex_counts (n,).
+Bodies = collections.namedtuple('Bodies', 'fixed_frame names masses inertias com_offsets vertex_counts')
+
+#: ``get_mass_matrix``: bodies (list of str), M, dM (None unless derivatives
+#: were asked for) and cos_theta ((n,) or (K, n): the gimbal-lock diagnostic).
+MassMatrices = collections.namedtuple('MassMatrices', 'bodies M dM cos_theta')
+
+
+def _numpy_service(service_class):
+    """The service type with a response that deserialises its arrays with np.frombuffer."""
+    return type('Numpy' + service_class.__name__, (object,), {
+        '_type': service_class._type,
+        '_md5sum': service_class._md5sum,
+        '_request_class': service_class._request_class,
+        '_response_class': numpy_msg(service_class._response_class),
+    })
+
+
+def _floats(values):
+    """A flat list of floats for a float64[] request field (struct.pack takes lists fastest)."""
+    return np.asarray(values, dtype=np.float64).ravel().tolist()
+
+
+def _indices(vertices):
+    return [] if vertices is None else np.asarray(vertices, dtype=np.uint32).ravel().tolist()
+
+
+def _pose(q):
+    """A request's optional q: empty = the node's current state, else 6 values."""
+    return [] if q is None else _floats(q)
+
+
+class RigidBodyClient(object):
+    """Persistent-connection client of one rigid_body_server.
+
+    :param server: the node's name, resolved like any ROS name (a relative name
+        lands in the caller's namespace), e.g. ``/rigid_body_server`` or
+        ``/robot1/rigid_body_server``.
+    :param timeout: [s] how long to wait for a service when connecting or
+        reconnecting.
+
+    ``rospy.init_node`` is not required for calls.
+    """
+
+    SERVICES = {
+        'get_bodies': GetBodies,
+        'set_state': SetState,
+        'get_state': GetState,
+        'get_mass_matrix': GetMassMatrix,
+        'get_vertex_jacobians': GetVertexJacobians,
+        'backprop': Backprop,
+    }
+
+    def __init__(self, server='rigid_body_server', timeout=30.0):
+        self.server = rospy.resolve_name(server)
+        self.timeout = timeout
+        self._proxies = {}
+
+    # ------------------------------------------------------------------ plumbing
+    def _proxy(self, name):
+        proxy = self._proxies.get(name)
+        if proxy is None:
+            resolved = '%s/%s' % (self.server, name)
+            rospy.wait_for_service(resolved, timeout=self.timeout)
+            proxy = rospy.ServiceProxy(resolved, _numpy_service(self.SERVICES[name]), persistent=True)
+            self._proxies[name] = proxy
+        return proxy
+
+    def _drop(self, name):
+        proxy = self._proxies.pop(name, None)
+        if proxy is not None:
+            proxy.close()
+
+    def call(self, name, **request):
+        """Calls service ``name`` with the request fields given; returns the
+        response (numpy arrays) or raises :class:`DiffRigidBodyError`."""
+        request_class = self.SERVICES[name]._request_class
+        message = request_class(**request)
+        try:
+            response = self._proxy(name).call(message)
+        except (rospy.ServiceException, rospy.exceptions.TransportException, OSError):
+            # The persistent connection dropped (e.g. the node restarted):
+            # reconnect once and retry. A second failure propagates.
+            self._drop(name)
+            response = self._proxy(name).call(message)
+        if not response.success:
+            raise DiffRigidBodyError('%s/%s' % (self.server, name), response.message)
+        return response
+
+    def connect(self, services=None):
+        """Opens the persistent connections now (``services``: names, None =
+        all six), so that the first calls do not pay for the set-up."""
+        for name in services or self.SERVICES:
+            self._proxy(name)
+        return self
+
+    def close(self):
+        """Closes every persistent connection (they reopen on the next call)."""
+        for name in list(self._proxies):
+            self._drop(name)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    # ------------------------------------------------------------------ services
+    def bodies(self):
+        """The scene: a :data:`Bodies` tuple."""
+        r = self.call('get_bodies')
+        n = len(r.names)
+        return Bodies(r.fixed_frame, list(r.names), np.asarray(r.masses), np.asarray(r.inertias).reshape(n, 3, 3),
+                      np.asarray(r.com_offsets).reshape(n, 3), np.asarray(r.vertex_counts))
+
+    def get_state(self, bodies=None):
+        """dict body name -> q (6,), in the node's order (``bodies`` None = all)."""
+        r = self.call('get_state', bodies=list(bodies or []))
+        return collections.OrderedDict((s.name, np.asarray(s.q)) for s in r.states)
+
+    def set_state(self, states):
+        """Sets states, all or nothing. ``states``: dict name -> q (6,), or
+        pairs (name, q)."""
+        items = states.items() if hasattr(states, 'items') else states
+        self.call('set_state', states=[BodyState(name=name, q=_floats(q)) for name, q in items])
+
+    def mass_matrix(self, bodies=None, q=None, derivatives=False):
+        """M(q) of ``bodies`` (None = all), as :data:`MassMatrices`.
+
+        ``q``: None = the current state (M is (n, 6, 6)); an (n, 6) array
+        (or 6n values) = one configuration (M is (n, 6, 6)); a (K, n, 6) array =
+        K configurations in one call (M is (K, n, 6, 6)). The node's state is
+        not changed. With ``derivatives``, dM has one more axis of 6 after the
+        body axis: ``dM[..., i, j, :, :]`` = dM/dq_j of body i.
+        """
+        batched = q is not None and np.ndim(q) == 3
+        r = self.call('get_mass_matrix', bodies=list(bodies or []), q=_pose(q), derivatives=bool(derivatives))
+        n = len(r.bodies)
+        shape = (-1, n) if batched else (n,)
+        M = np.asarray(r.mass_matrices).reshape(shape + (6, 6))
+        dM = np.asarray(r.derivatives).reshape(shape + (6, 6, 6)) if derivatives else None
+        return MassMatrices(list(r.bodies), M, dM, np.asarray(r.cos_theta).reshape(shape))
+
+    def vertex_jacobians(self, body, q=None, vertices=None):
+        """positions (N, 3) [m, fixed frame] and J (N, 3, 6) = dp/dq of ``body``'s
+        ``vertices`` (None = all) at ``q`` (None = current state, else (6,))."""
+        r = self.call('get_vertex_jacobians', body=body, vertices=_indices(vertices), q=_pose(q))
+        return np.asarray(r.positions).reshape(-1, 3), np.asarray(r.jacobians).reshape(-1, 3, 6)
+
+    def positions(self, body, q=None, vertices=None):
+        """positions (N, 3) [m] only (the same service; J is discarded)."""
+        return self.vertex_jacobians(body, q, vertices)[0]
+
+    def backprop(self, body, gradients, q=None, vertices=None):
+        """dL/dq (6,) from ``gradients`` = dL/dp, (N, 3), of ``body``'s ``vertices``
+        (None = all) at ``q`` (None = current state). J is never formed."""
+        r = self.call('backprop', body=body, vertices=_indices(vertices), gradients=_floats(gradients), q=_pose(q))
+        return np.asarray(r.gradient)

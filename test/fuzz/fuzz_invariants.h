@@ -1,0 +1,59 @@
+// Shared checks of the libFuzzer targets: a violated invariant aborts with a
+// message, which libFuzzer reports as a crash and saves the input for.
+#pragma once
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include "diff_rigid_body/scene_queries.h"
+
+namespace drb_fuzz
+{
+namespace drb = diff_rigid_body;
+
+[[noreturn]] inline void violated(const std::string& what)
+{
+  std::fprintf(stderr, "INVARIANT VIOLATED: %s\n", what.c_str());
+  std::abort();
+}
+
+inline void require(bool condition, const std::string& what)
+{
+  if (!condition)
+    violated(what);
+}
+
+inline void requireAllFinite(const double* values, std::size_t count, const std::string& what)
+{
+  for (std::size_t i = 0; i < count; ++i)
+    if (!std::isfinite(values[i]))
+      violated(what + "[" + std::to_string(i) + "] is not finite");
+}
+
+/// Every loaded scene: at least one body; finite mass > 0, finite
+/// symmetric inertia, finite COM, vertices and initial state; finite static
+/// link poses.
+inline void requireValidScene(const drb::Scene& scene)
+{
+  require(!scene.bodies.empty(), "a loaded scene has no body");
+  for (const drb::SceneBody& scene_body : scene.bodies)
+  {
+    const drb::RigidBody& body = scene_body.body;
+    const std::string where = "body '" + body.name + "': ";
+    require(std::isfinite(body.mass) && body.mass > 0.0, where + "mass not finite and > 0");
+    require(std::isnormal(body.mass), where + "subnormal mass");
+    require(body.inertia_body.allFinite(), where + "inertia not finite");
+    require(body.com_offset.allFinite(), where + "COM offset not finite");
+    require(body.vertices.allFinite(), where + "vertices not finite");
+    require(scene_body.initial_state.allFinite(), where + "initial state not finite");
+    for (const drb::LinkInBody& link : scene_body.links)
+      require(link.pose_in_body_link.matrix().allFinite(), where + "link pose not finite");
+    require(scene.findBody(body.name) >= 0, where + "not found by name");
+  }
+  for (const drb::StaticLink& link : scene.static_links)
+    require(link.pose_in_fixed_frame.matrix().allFinite(), "static link '" + link.name + "': pose not finite");
+}
+
+}  // namespace drb_fuzz

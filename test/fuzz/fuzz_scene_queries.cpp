@@ -1,0 +1,308 @@
+// libFuzzer target: the decoding and validation of every service request,
+// on SceneQueries over a small fixed scene (two bodies from primitives, one
+// with a merged link; no files are read).
+//
+// The input is decoded with FuzzedDataProvider into up to 8 requests, each
+// one of set_state, get_state, get_mass_matrix, get_vertex_jacobians and
+// backprop, with fuzzed body names (known, unknown, empty, repeated, random
+// bytes), q and gradients (any double: NaN, +-Inf, subnormals, +-0, huge,
+// or plain values), vertex indices (in range or any uint32) and sizes.
+// set_state changes the current state that later requests see, so queries
+// also run on extreme (finite) states.
+//
+// Invariants: a request either throws InvalidArgumentError and leaves its
+// outputs untouched, or answers with the documented sizes and only finite
+// numbers; set_state is all or nothing and stores q bit for bit.
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <fuzzer/FuzzedDataProvider.h>
+
+#include "diff_rigid_body/exceptions.h"
+#include "diff_rigid_body/scene_queries.h"
+#include "diff_rigid_body/urdf_scene.h"
+#include "fuzz_invariants.h"
+
+namespace
+{
+namespace drb = diff_rigid_body;
+using drb_fuzz::require;
+using drb_fuzz::requireAllFinite;
+
+const char* const kUrdf =
+    "<robot name=\"fuzz\"><link name=\"world\"/>"
+    "<link name=\"cube\"><inertial><origin xyz=\"0.01 0.02 0.03\" rpy=\"0.1 0.2 0.3\"/><mass value=\"2\"/>"
+    "<inertia ixx=\"0.1\" iyy=\"0.2\" izz=\"0.25\" ixy=\"0.01\" ixz=\"0.02\" iyz=\"-0.03\"/></inertial>"
+    "<collision><geometry><box size=\"0.2 0.3 0.4\"/></geometry></collision></link>"
+    "<link name=\"cap\"><collision><origin xyz=\"0 0 0.1\"/><geometry><cylinder radius=\"0.05\" length=\"0.1\"/>"
+    "</geometry></collision></link>"
+    "<joint name=\"cap_joint\" type=\"fixed\"><parent link=\"cube\"/><child link=\"cap\"/>"
+    "<origin xyz=\"0 0 0.2\"/></joint>"
+    "<link name=\"ball\"><inertial><mass value=\"1\"/><inertia ixx=\"0.004\" iyy=\"0.004\" izz=\"0.004\" ixy=\"0\" "
+    "ixz=\"0\" iyz=\"0\"/></inertial><collision><geometry><sphere radius=\"0.1\"/></geometry></collision></link>"
+    "<joint name=\"jc\" type=\"floating\"><parent link=\"world\"/><child link=\"cube\"/>"
+    "<origin xyz=\"0 0 1\" rpy=\"0.1 0.2 0.3\"/></joint>"
+    "<joint name=\"jb\" type=\"revolute\"><parent link=\"world\"/><child link=\"ball\"/>"
+    "<origin xyz=\"1 0 1\"/><axis xyz=\"0 0 1\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1\"/>"
+    "</joint></robot>";
+
+const drb::SceneQueries& queries()
+{
+  static const drb::SceneQueries instance(drb::loadSceneFromUrdf(kUrdf));
+  return instance;
+}
+
+double fuzzedDouble(FuzzedDataProvider& in)
+{
+  static const double kSpecial[] = { std::numeric_limits<double>::quiet_NaN(),
+                                     -std::numeric_limits<double>::quiet_NaN(),
+                                     std::numeric_limits<double>::infinity(),
+                                     -std::numeric_limits<double>::infinity(),
+                                     std::numeric_limits<double>::denorm_min(),
+                                     -std::numeric_limits<double>::denorm_min(),
+                                     std::numeric_limits<double>::min(),
+                                     std::numeric_limits<double>::max(),
+                                     std::numeric_limits<double>::lowest(),
+                                     0.0,
+                                     -0.0,
+                                     1.5707963267948966,
+                                     -1.5707963267948966,
+                                     1e154,
+                                     1e308,
+                                     1.0 };
+  switch (in.ConsumeIntegralInRange<int>(0, 3))
+  {
+    case 0:
+      return in.PickValueInArray(kSpecial);
+    case 1:
+    {
+      std::uint64_t bits = in.ConsumeIntegral<std::uint64_t>();  // any IEEE pattern, NaN payloads included
+      double value;
+      std::memcpy(&value, &bits, sizeof value);
+      return value;
+    }
+    case 2:
+      return in.ConsumeFloatingPoint<double>();
+    default:
+      return in.ConsumeFloatingPointInRange<double>(-10.0, 10.0);
+  }
+}
+
+std::string fuzzedName(FuzzedDataProvider& in)
+{
+  static const char* const kNames[] = { "cube", "ball", "cap", "world", "", "ghost", "cube " };
+  if (in.ConsumeBool())
+    return in.PickValueInArray(kNames);
+  return in.ConsumeRandomLengthString(24);
+}
+
+std::vector<double> fuzzedDoubles(FuzzedDataProvider& in, std::size_t max_count)
+{
+  std::vector<double> values(in.ConsumeIntegralInRange<std::size_t>(0, max_count));
+  // Often a size the service expects, so that validation goes past the size checks.
+  for (double& value : values)
+    value = fuzzedDouble(in);
+  return values;
+}
+
+std::vector<std::uint32_t> fuzzedVertices(FuzzedDataProvider& in)
+{
+  std::vector<std::uint32_t> vertices(in.ConsumeIntegralInRange<std::size_t>(0, 24));
+  for (std::uint32_t& v : vertices)
+    v = in.ConsumeBool() ? in.ConsumeIntegralInRange<std::uint32_t>(0, 120) : in.ConsumeIntegral<std::uint32_t>();
+  return vertices;
+}
+
+std::vector<std::string> fuzzedNames(FuzzedDataProvider& in)
+{
+  std::vector<std::string> names(in.ConsumeIntegralInRange<std::size_t>(0, 4));
+  for (std::string& name : names)
+    name = fuzzedName(in);
+  return names;
+}
+
+void setState(FuzzedDataProvider& in, drb::SceneState& current)
+{
+  std::vector<drb::NamedState> updates(in.ConsumeIntegralInRange<std::size_t>(0, 4));
+  for (drb::NamedState& update : updates)
+  {
+    update.name = fuzzedName(in);
+    for (int k = 0; k < 6; ++k)
+      update.q[k] = fuzzedDouble(in);
+  }
+  drb::SceneState next;
+  try
+  {
+    next = queries().applyStates(current, updates);
+  }
+  catch (const drb::InvalidArgumentError&)
+  {
+    return;  // all or nothing: `current` is untouched (it is const in the call)
+  }
+  require(next.size() == current.size(), "set_state: state size changed");
+  std::vector<bool> updated(current.size(), false);
+  for (const drb::NamedState& update : updates)
+  {
+    const int index = queries().scene().findBody(update.name);
+    require(index >= 0, "set_state accepted an unknown body");
+    require(!updated[index], "set_state accepted a repeated body");
+    updated[index] = true;
+    require(std::memcmp(next[index].data(), update.q.data(), sizeof(double) * 6) == 0,
+            "set_state did not store q bit for bit");
+  }
+  for (std::size_t i = 0; i < next.size(); ++i)
+  {
+    requireAllFinite(next[i].data(), 6, "state");
+    if (!updated[i])
+      require(std::memcmp(next[i].data(), current[i].data(), sizeof(double) * 6) == 0,
+              "set_state changed a body it was not given");
+  }
+  current = next;
+}
+
+void getState(FuzzedDataProvider& in, const drb::SceneState& current)
+{
+  const std::vector<std::string> names = fuzzedNames(in);
+  try
+  {
+    const std::vector<drb::NamedState> states = queries().getStates(current, names);
+    require(states.size() == (names.empty() ? current.size() : names.size()), "get_state: wrong count");
+    for (std::size_t i = 0; i < names.size(); ++i)
+      require(states[i].name == names[i], "get_state: wrong name");
+  }
+  catch (const drb::InvalidArgumentError&)
+  {
+  }
+}
+
+void getMassMatrix(FuzzedDataProvider& in, const drb::SceneState& current)
+{
+  const std::vector<std::string> names = fuzzedNames(in);
+  const bool derivatives = in.ConsumeBool();
+  std::vector<double> q;
+  if (in.ConsumeBool())
+  {
+    // A plausible size: K x 6 x n values, sometimes off by one.
+    const std::size_t n = names.empty() ? current.size() : names.size();
+    q.resize(in.ConsumeIntegralInRange<std::size_t>(0, 3) * 6 * n + (in.ConsumeBool() ? 1 : 0));
+    for (double& value : q)
+      value = fuzzedDouble(in);
+  }
+  else
+    q = fuzzedDoubles(in, 48);
+  try
+  {
+    const drb::MassMatrixAnswer answer = queries().massMatrices(current, names, q, derivatives);
+    const std::size_t n = names.empty() ? current.size() : names.size();
+    const std::size_t matrices = q.empty() ? n : q.size() / 6;
+    require(answer.bodies.size() == n, "get_mass_matrix: wrong body count");
+    require(answer.mass_matrices.size() == 36 * matrices, "get_mass_matrix: wrong matrix count");
+    require(answer.cos_theta.size() == matrices, "get_mass_matrix: wrong cos_theta count");
+    require(answer.derivatives.size() == (derivatives ? 216 * matrices : 0), "get_mass_matrix: wrong derivatives");
+    requireAllFinite(answer.mass_matrices.data(), answer.mass_matrices.size(), "mass_matrices");
+    requireAllFinite(answer.derivatives.data(), answer.derivatives.size(), "derivatives");
+    requireAllFinite(answer.cos_theta.data(), answer.cos_theta.size(), "cos_theta");
+  }
+  catch (const drb::InvalidArgumentError&)
+  {
+  }
+}
+
+std::vector<double> fuzzedQ(FuzzedDataProvider& in)
+{
+  if (in.ConsumeBool())
+    return {};
+  if (in.ConsumeBool())
+  {
+    std::vector<double> q(6);
+    for (double& value : q)
+      value = fuzzedDouble(in);
+    return q;
+  }
+  return fuzzedDoubles(in, 8);
+}
+
+void getVertexJacobians(FuzzedDataProvider& in, const drb::SceneState& current)
+{
+  const std::string body = fuzzedName(in);
+  const std::vector<std::uint32_t> vertices = fuzzedVertices(in);
+  const std::vector<double> q = fuzzedQ(in);
+  std::vector<double> positions{ 42.0 }, jacobians{ 43.0 };
+  try
+  {
+    queries().vertexJacobians(current, body, vertices, q, positions, jacobians);
+  }
+  catch (const drb::InvalidArgumentError&)
+  {
+    require(positions == std::vector<double>{ 42.0 } && jacobians == std::vector<double>{ 43.0 },
+            "get_vertex_jacobians: a refused request wrote its outputs");
+    return;
+  }
+  const int index = queries().scene().findBody(body);
+  require(index >= 0, "get_vertex_jacobians accepted an unknown body");
+  const std::size_t count =
+      vertices.empty() ? static_cast<std::size_t>(queries().body(index).vertices.cols()) : vertices.size();
+  require(positions.size() == 3 * count && jacobians.size() == 18 * count, "get_vertex_jacobians: wrong sizes");
+  requireAllFinite(positions.data(), positions.size(), "positions");
+  requireAllFinite(jacobians.data(), jacobians.size(), "jacobians");
+}
+
+void backprop(FuzzedDataProvider& in, const drb::SceneState& current)
+{
+  const std::string body = fuzzedName(in);
+  const std::vector<std::uint32_t> vertices = fuzzedVertices(in);
+  const std::vector<double> q = fuzzedQ(in);
+  std::vector<double> gradients;
+  const int index = queries().scene().findBody(body);
+  if (index >= 0 && in.ConsumeBool())
+  {
+    // The expected size, so that the values are what is tested.
+    const std::size_t count =
+        vertices.empty() ? static_cast<std::size_t>(queries().body(index).vertices.cols()) : vertices.size();
+    gradients.resize(3 * count + (in.ConsumeIntegralInRange<int>(0, 7) == 0 ? 1 : 0));
+    for (double& value : gradients)
+      value = fuzzedDouble(in);
+  }
+  else
+    gradients = fuzzedDoubles(in, 48);
+  try
+  {
+    const drb::Vector6<double> gradient = queries().backprop(current, body, vertices, gradients, q);
+    requireAllFinite(gradient.data(), 6, "backprop gradient");
+  }
+  catch (const drb::InvalidArgumentError&)
+  {
+  }
+}
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
+{
+  FuzzedDataProvider in(data, size);
+  drb::SceneState current = queries().initialState();
+  for (int request = 0; request < 8 && in.remaining_bytes() > 0; ++request)
+  {
+    switch (in.ConsumeIntegralInRange<int>(0, 4))
+    {
+      case 0:
+        setState(in, current);
+        break;
+      case 1:
+        getState(in, current);
+        break;
+      case 2:
+        getMassMatrix(in, current);
+        break;
+      case 3:
+        getVertexJacobians(in, current);
+        break;
+      default:
+        backprop(in, current);
+        break;
+    }
+  }
+  return 0;
+}

@@ -1,0 +1,144 @@
+// The C++ client header (include/diff_rigid_body_ros/rigid_body_client.h)
+// against the real node on the default scene (clients_cpp.test): Eigen
+// shapes, layout, errors, and a Gauss-Newton pose fit built on it.
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+
+#include "diff_rigid_body_ros/rigid_body_client.h"
+
+namespace
+{
+using diff_rigid_body_ros::Matrix6d;
+using diff_rigid_body_ros::RigidBodyClient;
+using diff_rigid_body_ros::Vector6d;
+
+constexpr double MATRIX_TOLERANCE = 1e-12;   // relative, of the largest entry
+constexpr double FD_TOLERANCE = 1e-7;        // m per unit of q (central differences, h = 1e-6)
+constexpr double FIT_TOLERANCE = 1e-8;       // rad and m
+
+Vector6d hiddenPose()
+{
+  Vector6d q;
+  q << 0.3, -0.4, 1.1, 0.05, -0.1, 0.6;
+  return q;
+}
+
+TEST(CppClient, BodiesOfTheDefaultScene)
+{
+  RigidBodyClient client;
+  const diff_rigid_body_ros::Bodies bodies = client.bodies();
+  EXPECT_EQ(bodies.fixed_frame, "world");
+  ASSERT_EQ(bodies.names, (std::vector<std::string>{ "knot", "rock" }));
+  EXPECT_EQ(bodies.vertex_counts.at(0), 4096u);
+  EXPECT_NEAR(bodies.masses.at(0), 0.28125334, 1e-12);
+  EXPECT_NEAR(bodies.inertias.at(0)(2, 2), 6.0365524e-04, 1e-12);
+}
+
+TEST(CppClient, BatchedMassMatricesMatchSingleCallsAndLayout)
+{
+  RigidBodyClient client;
+  const std::vector<std::string> names{ "knot", "rock" };
+  std::vector<double> q;  // K = 3 configurations of both bodies
+  for (int k = 0; k < 3; ++k)
+    for (int i = 0; i < 2; ++i)
+      for (int c = 0; c < 6; ++c)
+        q.push_back(0.1 * (k + 1) * (c + 1) - 0.2 * i);
+  const auto batch = client.massMatrices(names, q, /*derivatives=*/true);
+  ASSERT_EQ(batch.configurations, 3u);
+  ASSERT_EQ(batch.M.size(), 6u);
+  ASSERT_EQ(batch.dM.size(), 6u);
+  const auto bodies = client.bodies();
+  for (std::size_t k = 0; k < 3; ++k)
+    for (std::size_t i = 0; i < 2; ++i)
+    {
+      Vector6d qi = Eigen::Map<const Vector6d>(q.data() + (k * 2 + i) * 6);
+      const Matrix6d single = client.massMatrix(names[i], qi);
+      EXPECT_LE((batch.at(k, i) - single).cwiseAbs().maxCoeff(), MATRIX_TOLERANCE * single.cwiseAbs().maxCoeff());
+      // Lower block m I3; dM/dpsi = 0.
+      EXPECT_NEAR(batch.at(k, i)(3, 3), bodies.masses[i], 1e-12);
+      EXPECT_EQ(batch.dM[k * 2 + i][2].cwiseAbs().maxCoeff(), 0.0);
+      EXPECT_NEAR(batch.cos_theta[k * 2 + i], std::cos(qi[1]), 1e-15);
+    }
+}
+
+TEST(CppClient, JacobiansMatchFiniteDifferencesAndBackprop)
+{
+  RigidBodyClient client;
+  const Vector6d q = hiddenPose();
+  const std::vector<std::uint32_t> vertices{ 0, 17, 4095 };
+  const auto answer = client.vertexJacobians("knot", q, vertices);
+  ASSERT_EQ(answer.positions.cols(), 3);
+  ASSERT_EQ(answer.J.rows(), 9);
+  const double h = 1e-6;
+  for (int j = 0; j < 6; ++j)
+  {
+    Vector6d plus = q, minus = q;
+    plus[j] += h;
+    minus[j] -= h;
+    const Eigen::Matrix3Xd column = (client.vertexJacobians("knot", plus, vertices).positions -
+                                     client.vertexJacobians("knot", minus, vertices).positions) /
+                                    (2 * h);
+    for (int v = 0; v < 3; ++v)
+      EXPECT_LE((answer.jacobian(v).col(j) - column.col(v)).cwiseAbs().maxCoeff(), FD_TOLERANCE)
+          << "vertex " << vertices[v] << ", column " << j;
+  }
+  Eigen::Matrix3Xd g(3, 3);
+  g << 1, 0, 2, 0, -1, 0.5, 3, 1, 0;
+  const Vector6d expected = answer.J.transpose() * Eigen::Map<const Eigen::VectorXd>(g.data(), 9);
+  EXPECT_LE((client.backprop("knot", g, q, vertices) - expected).cwiseAbs().maxCoeff(), 1e-12);
+}
+
+TEST(CppClient, RefusalThrowsServiceErrorWithTheNodesMessage)
+{
+  RigidBodyClient client;
+  try
+  {
+    client.vertexJacobians("no_such_body");
+    FAIL() << "no exception";
+  }
+  catch (const diff_rigid_body_ros::ServiceError& e)
+  {
+    EXPECT_NE(e.message().find("no_such_body"), std::string::npos) << e.message();
+    EXPECT_NE(e.service().find("get_vertex_jacobians"), std::string::npos) << e.service();
+  }
+  // The client still works after a refusal.
+  EXPECT_EQ(client.bodies().names.size(), 2u);
+}
+
+TEST(CppClient, GaussNewtonRecoversAHiddenPose)
+{
+  RigidBodyClient client;
+  const Vector6d hidden = hiddenPose();
+  const Eigen::Matrix3Xd target = client.vertexJacobians("rock", hidden).positions;
+  Vector6d q = hidden;
+  q.head<3>() += Eigen::Vector3d(0.3, -0.2, 0.25);  // about 26 degrees
+  q.tail<3>() += Eigen::Vector3d(0.1, 0.15, -0.08);  // 0.2 m
+  int iterations = 0;
+  for (; iterations < 30; ++iterations)
+  {
+    const auto answer = client.vertexJacobians("rock", q);
+    const Eigen::Matrix3Xd residual = answer.positions - target;
+    const Eigen::Map<const Eigen::VectorXd> r(residual.data(), residual.size());
+    const Vector6d step = answer.J.colPivHouseholderQr().solve(-r);
+    q += step;
+    if (step.cwiseAbs().maxCoeff() < 1e-13)
+      break;
+  }
+  EXPECT_LT(iterations, 30);
+  EXPECT_LE((q - hidden).cwiseAbs().maxCoeff(), FIT_TOLERANCE) << "q = " << q.transpose();
+}
+
+}  // namespace
+
+int main(int argc, char** argv)
+{
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "clients_cpp_test");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}
