@@ -11,16 +11,10 @@ against a running rigid_body_server (the default scene).
 Usage: demo_client.py [--body knot] [--noise 0.001] [--configurations 1000]
 """
 import argparse
-import os
 import sys
 
-try:
-    import rospy
-except ImportError:  # a private python3 without ROS came first on PATH: use Debian's
-    if os.path.realpath(sys.executable) != os.path.realpath('/usr/bin/python3'):
-        os.execv('/usr/bin/python3', ['/usr/bin/python3'] + sys.argv)
-    raise
 import numpy as np
+import rospy
 
 from diff_rigid_body.client import DiffRigidBodyError, RigidBodyClient
 from diff_rigid_body import pose_fitting, trajectory_energy

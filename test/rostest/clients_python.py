@@ -12,20 +12,13 @@ node on the default scene (clients_python.test).
 """
 import os
 import signal
-import sys
 import time
 import unittest
-
-try:
-    import rospy
-except ImportError:  # a private python3 without ROS came first on PATH: use Debian's
-    if os.path.realpath(sys.executable) != os.path.realpath('/usr/bin/python3'):
-        os.execv('/usr/bin/python3', ['/usr/bin/python3'] + sys.argv)
-    raise
 import xmlrpc.client
 
 import numpy as np
 import rosgraph
+import rospy
 import rostest
 
 from diff_rigid_body.client import DiffRigidBodyError, RigidBodyClient

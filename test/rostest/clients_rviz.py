@@ -20,13 +20,8 @@ import sys
 import tempfile
 import unittest
 
-try:
-    import rospy
-except ImportError:  # a private python3 without ROS came first on PATH: use Debian's
-    if os.path.realpath(sys.executable) != os.path.realpath('/usr/bin/python3'):
-        os.execv('/usr/bin/python3', ['/usr/bin/python3'] + sys.argv)
-    raise
 import numpy as np
+import rospy
 import rostest
 
 from diff_rigid_body import rviz_capture as rc

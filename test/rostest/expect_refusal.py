@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Runs rigid_body_server on a bad description and expects a clean refusal.
 
 The real node binary is started as a subprocess against the rostest master.
@@ -11,19 +11,11 @@ Private parameters of this test node (set them in the .test file):
   ~robot_description_file   file whose text becomes the node's robot_description
   ~timeout                  [s] how long the node may take to give up (default 30)
 """
-import os
 import subprocess
 import sys
 import unittest
 
-try:
-    import rospy
-except ImportError:
-    # A private python3 without ROS came first on PATH: use Debian's.
-    if os.path.realpath(sys.executable) != os.path.realpath('/usr/bin/python3') and os.access(
-            '/usr/bin/python3', os.X_OK):
-        os.execv('/usr/bin/python3', ['/usr/bin/python3'] + sys.argv)
-    raise
+import rospy
 import roslib.packages
 import rostest
 

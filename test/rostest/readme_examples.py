@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Runs the `rosservice call` examples of README.md against the running node.
 
 Every ```bash block of README.md that contains `rosservice call` is taken;
@@ -13,14 +13,7 @@ import subprocess
 import sys
 import unittest
 
-try:
-    import rospy
-except ImportError:
-    # A private python3 without ROS came first on PATH: use Debian's.
-    if os.path.realpath(sys.executable) != os.path.realpath('/usr/bin/python3') and os.access(
-            '/usr/bin/python3', os.X_OK):
-        os.execv('/usr/bin/python3', ['/usr/bin/python3'] + sys.argv)
-    raise
+import rospy
 import rospkg
 import rostest
 

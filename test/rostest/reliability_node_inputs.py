@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Bad node parameters (P rows) and hostile ROS-level input (T rows) of the
 catalogue in docs/robustness.md (reliability_node_inputs.test).
 
@@ -8,24 +8,16 @@ it keeps serving, and that the catalogue row in docs/robustness.md quotes
 the same message.
 """
 import math
-import os
 import socket
 import struct
-import sys
 import time
 import unittest
 
-try:
-    import rospy
-except ImportError:
-    if os.path.realpath(sys.executable) != os.path.realpath('/usr/bin/python3') and os.access(
-            '/usr/bin/python3', os.X_OK):
-        os.execv('/usr/bin/python3', ['/usr/bin/python3'] + sys.argv)
-    raise
 import rosgraph
+import rospy
 import rostest
 from diff_rigid_body.msg import BodyState, BodyStateArray
-from diff_rigid_body.srv import GetState, GetVertexJacobians, SetState
+from diff_rigid_body.srv import GetState, GetVertexJacobians
 from reliability_node import Node, doc_row, raw_service_call, string_field
 
 PKG = 'diff_rigid_body'

@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """The durable-state cycle (reliability_respawn.test).
 
 server.launch runs rigid_body_server with respawn:=true and a ~state_file.
@@ -27,15 +27,8 @@ import time
 import unittest
 import xmlrpc.client
 
-try:
-    import rospy
-except ImportError:
-    # A private python3 without ROS came first on PATH: use Debian's.
-    if os.path.realpath(sys.executable) != os.path.realpath('/usr/bin/python3') and os.access(
-            '/usr/bin/python3', os.X_OK):
-        os.execv('/usr/bin/python3', ['/usr/bin/python3'] + sys.argv)
-    raise
 import rosgraph
+import rospy
 import rostest
 from diff_rigid_body.msg import BodyState
 from diff_rigid_body.srv import GetState, SetState

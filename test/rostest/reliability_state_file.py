@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """The node's use of ~state_file (reliability_state_file.test).
 
 Runs the real rigid_body_server binary as a subprocess (like
@@ -18,16 +18,9 @@ import shutil
 import struct
 import sys
 import tempfile
-import time
 import unittest
 
-try:
-    import rospy
-except ImportError:
-    if os.path.realpath(sys.executable) != os.path.realpath('/usr/bin/python3') and os.access(
-            '/usr/bin/python3', os.X_OK):
-        os.execv('/usr/bin/python3', ['/usr/bin/python3'] + sys.argv)
-    raise
+import rospy
 import rostest
 from reliability_node import SCENE, Node
 from diff_rigid_body.msg import BodyState
