@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "diff_rigid_body/urdf_scene.h"
+#include "diff_rigid_body/vertex_columns.h"
 
 namespace diff_rigid_body
 {
@@ -88,6 +89,20 @@ public:
                        const std::vector<double>& q, std::vector<double>& positions,
                        std::vector<double>& jacobians) const;
 
+  /// The reduced transport of vertexJacobians (~get_vertex_jacobians_compact):
+  /// positions (3 per vertex) and, unless `positions_only`, the rotation
+  /// block Jr = dp/d(phi, theta, psi) (9 per vertex, 3x3 row-major; the
+  /// translation block is always I3), stored as Out: double, or float for
+  /// the float32 transport. The checks and messages of vertexJacobians; a
+  /// request whose outputs would overflow Out is refused before anything is
+  /// written. Outputs are resized here (rotation_jacobians to 0 when
+  /// `positions_only`). Instantiated for Out = double and float.
+  template <typename Out>
+  void vertexRotationJacobians(const SceneState& current, const std::string& body,
+                               const std::vector<std::uint32_t>& vertices, const std::vector<double>& q,
+                               bool positions_only, std::vector<Out>& positions,
+                               std::vector<Out>& rotation_jacobians) const;
+
   /// dL/dq = sum_i J_i^T g_i for gradients g (3 per selected vertex).
   Vector6<double> backprop(const SceneState& current, const std::string& body,
                            const std::vector<std::uint32_t>& vertices, const std::vector<double>& gradients,
@@ -101,6 +116,9 @@ private:
 
   Scene scene_;
   std::vector<double> vertex_radius_;  ///< max_i |p0_i| per body [m]
+  /// Each body's vertices stored by coordinate, for the backprop of all
+  /// vertices (vertex_columns.h; 24 B per vertex).
+  std::vector<VertexColumns<double>> vertex_columns_;
   /// Body name -> index: O(1) lookups, so that a request of 10^5 states on a
   /// scene of 10^5 bodies is not quadratic.
   std::unordered_map<std::string, std::size_t> body_index_;

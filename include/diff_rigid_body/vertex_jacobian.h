@@ -502,6 +502,21 @@ void vertexPositionsAndRotationJacobians(const BodyPose<Scalar>& pose, const Mat
   }
 }
 
+/// dL/dq from the two per-body sums of the backprop (see the top of this
+/// file): W = sum_i g_i p0_i^T and force = sum_i g_i.
+///   dL/dr = T^T (X12 - X21, X20 - X02, X01 - X10) with X = R W^T,
+///   dL/dt = force.
+template <typename Scalar>
+Vector6<Scalar> backpropFromSums(const BodyPose<Scalar>& pose, const Matrix3<Scalar>& W, const Vector3<Scalar>& force)
+{
+  const Matrix3<Scalar> X = pose.R * W.transpose();  // sum_i (R p0_i) g_i^T
+  const Vector3<Scalar> torque(X(1, 2) - X(2, 1), X(2, 0) - X(0, 2), X(0, 1) - X(1, 0));
+  Vector6<Scalar> dL_dq;
+  dL_dq.template head<3>() = pose.T.transpose() * torque;
+  dL_dq.template tail<3>() = force;
+  return dL_dq;
+}
+
 /// dL/dq = sum_i J_i^T g_i without forming J.
 ///
 /// \param gradients dL/dp for each selected vertex, 3 per vertex, in the
@@ -532,12 +547,7 @@ Vector6<Scalar> backpropagateVertexGradients(const BodyPose<Scalar>& pose, const
       force += g;
     }
   }
-  const Matrix3<Scalar> X = pose.R * W.transpose();  // sum_i (R p0_i) g_i^T
-  const Vector3<Scalar> torque(X(1, 2) - X(2, 1), X(2, 0) - X(0, 2), X(0, 1) - X(1, 0));
-  Vector6<Scalar> dL_dq;
-  dL_dq.template head<3>() = pose.T.transpose() * torque;
-  dL_dq.template tail<3>() = force;
-  return dL_dq;
+  return backpropFromSums(pose, W, force);
 }
 
 }  // namespace diff_rigid_body

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
+#include <type_traits>
 #include <unordered_set>
 
 #include "diff_rigid_body/exceptions.h"
@@ -48,7 +50,10 @@ void requireFinite(const double* values, std::size_t count, const std::string& f
 SceneQueries::SceneQueries(Scene scene) : scene_(std::move(scene))
 {
   for (const SceneBody& body : scene_.bodies)
+  {
     vertex_radius_.push_back(body.body.vertices.cols() ? body.body.vertices.colwise().norm().maxCoeff() : 0.0);
+    vertex_columns_.emplace_back(body.body.vertices.transpose());
+  }
   for (std::size_t i = 0; i < scene_.bodies.size(); ++i)
     body_index_.emplace(scene_.bodies[i].body.name, i);  // the first of equal names, as Scene::findBody
 }
@@ -229,6 +234,42 @@ void SceneQueries::vertexJacobians(const SceneState& current, const std::string&
   vertexPositionsAndJacobians(pose, scene_.bodies[index].body.vertices, vertices, positions.data(), jacobians.data());
 }
 
+template <typename Out>
+void SceneQueries::vertexRotationJacobians(const SceneState& current, const std::string& body_name,
+                                           const std::vector<std::uint32_t>& vertices, const std::vector<double>& q,
+                                           bool positions_only, std::vector<Out>& positions,
+                                           std::vector<Out>& rotation_jacobians) const
+{
+  const std::size_t index = bodyIndex(body_name, "body");
+  const std::size_t count = checkVertices(index, vertices);
+  const BodyPose<double> pose(stateOrCurrent(current, index, q));
+  // B = |t|_inf + r, r = max_i |p0_i|, bounds every output: |p_k| <= |t_k| + |R p0|,
+  // and column j of Jr is T e_j x R p0 with |T e_j| = 1, so |Jr_kj| <= |p0|.
+  // Rounding (in R p0, the cross products and the norm behind r) adds less than
+  // 20 eps r, so with r inflated by 64 eps, B rounded to nearest <= max(Out)
+  // rules out inf in every output, with one check for all vertices. Up to
+  // that term (below an ulp of B unless r > 1e306 m) this is the test of
+  // vertexJacobians: B finite in double.
+  constexpr double kInflation = 1.0 + 64 * std::numeric_limits<double>::epsilon();
+  constexpr double kLimit = std::numeric_limits<Out>::max();
+  if (!(pose.t.cwiseAbs().maxCoeff() + kInflation * vertex_radius_[index] <= kLimit))
+    reject("q: position too large: vertex positions of body '" + body_name + "' would overflow" +
+           (std::is_same<Out, float>::value ? " float32" : ""));
+  positions.resize(3 * count);
+  rotation_jacobians.resize(positions_only ? 0 : 9 * count);
+  vertexPositionsAndRotationJacobians(pose, scene_.bodies[index].body.vertices, vertices, positions.data(),
+                                      positions_only ? nullptr : rotation_jacobians.data());
+}
+
+template void SceneQueries::vertexRotationJacobians<double>(const SceneState&, const std::string&,
+                                                            const std::vector<std::uint32_t>&,
+                                                            const std::vector<double>&, bool, std::vector<double>&,
+                                                            std::vector<double>&) const;
+template void SceneQueries::vertexRotationJacobians<float>(const SceneState&, const std::string&,
+                                                           const std::vector<std::uint32_t>&,
+                                                           const std::vector<double>&, bool, std::vector<float>&,
+                                                           std::vector<float>&) const;
+
 Vector6<double> SceneQueries::backprop(const SceneState& current, const std::string& body_name,
                                        const std::vector<std::uint32_t>& vertices,
                                        const std::vector<double>& gradients, const std::vector<double>& q) const
@@ -237,11 +278,19 @@ Vector6<double> SceneQueries::backprop(const SceneState& current, const std::str
   const std::size_t count = checkVertices(index, vertices);
   if (gradients.size() != 3 * count)
     reject(sizeMismatch("gradients", "3 per vertex = " + std::to_string(3 * count), gradients.size()));
-  requireFinite(gradients.data(), gradients.size(), "gradients");
   const BodyPose<double> pose(stateOrCurrent(current, index, q));
   const Vector6<double> gradient =
-      backpropagateVertexGradients(pose, scene_.bodies[index].body.vertices, vertices, gradients.data());
-  requireFinite(gradient.data(), 6, "result gradient (the gradients are too large)");
+      vertices.empty() ? backpropagateVertexGradients(pose, vertex_columns_[index], gradients.data())
+                       : backpropagateVertexGradients(pose, scene_.bodies[index].body.vertices, vertices,
+                                                      gradients.data());
+  // One pass over the gradients, not two: dL/dt = sum_i g_i is not finite
+  // whenever some g_i is not (inf and NaN never cancel back to a finite
+  // value), so only a non-finite answer needs the scan that names the index.
+  if (!gradient.allFinite())
+  {
+    requireFinite(gradients.data(), gradients.size(), "gradients");
+    requireFinite(gradient.data(), 6, "result gradient (the gradients are too large)");
+  }
   return gradient;
 }
 

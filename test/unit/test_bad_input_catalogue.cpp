@@ -506,6 +506,31 @@ std::string everyNonFinite(const std::function<void(int, double)>& call)
   throw drb::InvalidArgumentError(last);
 }
 
+// ~get_vertex_jacobians_compact of every vertex of a box body "b" of `size`
+// [m] at `q`, stored as Out (float: single_precision). A refusal must leave
+// the outputs untouched; an answer must be finite.
+template <typename Out>
+std::string compactOfBox(const std::string& size, const std::vector<double>& q)
+{
+  const drb::SceneQueries queries(
+      drb::loadSceneFromUrdf(oneBody(inertial() + collision("<box size=\"" + size + "\"/>"))));
+  std::vector<Out> positions{ Out(42) }, rotation_jacobians{ Out(42) };
+  try
+  {
+    queries.vertexRotationJacobians(queries.initialState(), "b", {}, q, false, positions, rotation_jacobians);
+  }
+  catch (const drb::Error&)
+  {
+    EXPECT_EQ(positions, std::vector<Out>{ Out(42) }) << "outputs written by a refused request";
+    EXPECT_EQ(rotation_jacobians, std::vector<Out>{ Out(42) }) << "outputs written by a refused request";
+    throw;
+  }
+  for (const std::vector<Out>* field : { &positions, &rotation_jacobians })
+    for (Out value : *field)
+      EXPECT_TRUE(std::isfinite(value));
+  return std::to_string(positions.size() / 3) + " vertices";
+}
+
 std::vector<Row> requestRows()
 {
   const drb::SceneState current = twoBodies().initialState();
@@ -664,6 +689,22 @@ std::vector<Row> requestRows()
     { "R33", "backprop: more than 2^22 vertex indices", Expect::Refused, "InvalidArgumentError",
       "at most 4194304 vertices",
       [=] { return grad("cube", std::vector<std::uint32_t>(drb::RequestLimits::kMaxVertices + 1, 0), {}, {}); } },
+    { "R34", "get_vertex_jacobians_compact: a body 1e300 m wide at a translation of 1.7e308 (positions would overflow)",
+      Expect::Refused, "InvalidArgumentError", "position too large",
+      [] { return compactOfBox<double>("1e300 1 1", { 0, 0, 0, 1.7e308, 0, 0 }); } },
+    { "R35", "get_vertex_jacobians_compact, single_precision: a translation of 3.5e38 (beyond float32's 3.4e38)",
+      Expect::Refused, "InvalidArgumentError", "overflow float32",
+      [] { return compactOfBox<float>("0.2 0.2 0.2", { 0, 0, 0, 0, 0, -3.5e38 }); } },
+    { "R36", "get_vertex_jacobians_compact, single_precision: a body 1e38 m wide at a translation of 3e38 "
+             "(each fits float32, their sum does not)",
+      Expect::Refused, "InvalidArgumentError", "overflow float32",
+      [] { return compactOfBox<float>("1e38 1 1", { 0, 0, 0, 3e38, 0, 0 }); } },
+    { "R37", "get_vertex_jacobians_compact, single_precision: a translation of 3.4e38 on a small body",
+      Expect::Accepted, "", "",
+      [] {
+        EXPECT_EQ(compactOfBox<float>("0.2 0.2 0.2", { 0, 0, 0, 3.4e38, 0, 0 }), "8 vertices");
+        return std::string("accepted: finite float32 positions (3.4e38 + 0.1 rounds to 3.4e38)");
+      } },
   };
 }
 

@@ -1,8 +1,10 @@
 // Service logic on plain arrays: layouts, snapshots and the refusal of bad
 // requests (each with a message naming the field, and no partial effect).
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -173,4 +175,130 @@ TEST(SceneQueries, RefusesBadRequests)
                              true);
       },
       "at most 100000 matrices");
+}
+
+// ~get_vertex_jacobians_compact: the positions and the rotation block (the
+// first three columns of J) of the full answer, in double bit for bit and in
+// float32 as the double values rounded once.
+TEST(SceneQueries, CompactTransportIsTheFullAnswerReduced)
+{
+  const drb::SceneQueries queries = twoBodyScene();
+  const drb::SceneState current = queries.initialState();
+  const std::vector<std::uint32_t> vertices = { 7, 0, 3, 7 };
+  const std::vector<double> q = { 0.4, -1.1, 2.5, -0.3, 0.2, 1.5 };
+  std::vector<double> positions, jacobians;
+  queries.vertexJacobians(current, "cube", vertices, q, positions, jacobians);
+
+  std::vector<double> compact_positions, rotation;
+  queries.vertexRotationJacobians(current, "cube", vertices, q, false, compact_positions, rotation);
+  ASSERT_EQ(compact_positions.size(), 12u);
+  ASSERT_EQ(rotation.size(), 36u);
+  EXPECT_EQ(compact_positions, positions);
+  std::vector<float> positions_f32, rotation_f32;
+  queries.vertexRotationJacobians(current, "cube", vertices, q, false, positions_f32, rotation_f32);
+  ASSERT_EQ(positions_f32.size(), 12u);
+  ASSERT_EQ(rotation_f32.size(), 36u);
+  for (std::size_t n = 0; n < vertices.size(); ++n)
+    for (int r = 0; r < 3; ++r)
+    {
+      EXPECT_EQ(positions_f32[3 * n + r], static_cast<float>(positions[3 * n + r]));
+      for (int c = 0; c < 3; ++c)
+      {
+        EXPECT_EQ(rotation[9 * n + 3 * r + c], jacobians[18 * n + 6 * r + c]);
+        EXPECT_EQ(rotation_f32[9 * n + 3 * r + c], static_cast<float>(jacobians[18 * n + 6 * r + c]));
+      }
+    }
+  // positions_only: the same positions, no rotation block.
+  std::vector<double> only_positions, no_rotation{ 42.0 };
+  queries.vertexRotationJacobians(current, "cube", vertices, q, true, only_positions, no_rotation);
+  EXPECT_EQ(only_positions, positions);
+  EXPECT_TRUE(no_rotation.empty());
+}
+
+// Results that would not fit the output type are refused (naming q and the
+// body) before anything is written, like get_vertex_jacobians: never inf.
+// FLT_MAX = 3.4028e38, DBL_MAX = 1.7977e308.
+TEST(SceneQueries, CompactTransportRefusesOverflow)
+{
+  const drb::SceneQueries queries = twoBodyScene();
+  const drb::SceneState current = queries.initialState();
+  // One floating body "b": a box of `size` [m] (vertices at +-size/2).
+  const auto boxBody = [](const std::string& size) {
+    return drb::SceneQueries(drb::loadSceneFromUrdf(
+        "<robot name=\"r\"><link name=\"world\"/><link name=\"b\"><inertial><mass value=\"1\"/><inertia ixx=\"1\" "
+        "iyy=\"1\" izz=\"1\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial><collision><geometry><box size=\"" +
+        size +
+        "\"/></geometry></collision></link><joint name=\"j\" type=\"floating\"><parent link=\"world\"/>"
+        "<child link=\"b\"/></joint></robot>"));
+  };
+  std::vector<float> positions_f32{ 42.0f }, rotation_f32{ 42.0f };
+  std::vector<double> positions{ 42.0 }, rotation{ 42.0 };
+
+  const drb::SceneQueries wide = boxBody("1e38 1 1"), wider = boxBody("1e39 1 1"), giant = boxBody("1e300 1 1");
+  struct Overflow
+  {
+    const drb::SceneQueries& queries;
+    std::string body;
+    std::vector<double> q;
+    bool single_precision;
+    bool positions_only;
+  };
+  const Overflow overflows[] = {
+    // float32: a translation beyond FLT_MAX (the 0.2 m cube), with and without the rotation block;
+    { queries, "cube", { 0, 0, 0, 0, -3.5e38, 0 }, true, false },
+    { queries, "cube", { 0, 0, 0, 0, -3.5e38, 0 }, true, true },
+    // float32: vertices at 5e37 m and a translation of 3e38 m each fit, their sum does not;
+    { wide, "b", { 0, 0, 0, 3e38, 0, 0 }, true, false },
+    // float32: a body 1e39 m wide, so |p0| and |Jr| exceed FLT_MAX at q = 0;
+    { wider, "b", { 0, 0, 0, 0, 0, 0 }, true, false },
+    // double: a body 1e300 m wide at 1.7e308 m (the message of get_vertex_jacobians).
+    { giant, "b", { 0, 0, 0, 1.7e308, 0, 0 }, false, false },
+  };
+  for (const Overflow& o : overflows)
+    expectRejected(
+        [&] {
+          const drb::SceneState state = o.queries.initialState();
+          if (o.single_precision)
+            o.queries.vertexRotationJacobians(state, o.body, {}, o.q, o.positions_only, positions_f32, rotation_f32);
+          else
+            o.queries.vertexRotationJacobians(state, o.body, {}, o.q, o.positions_only, positions, rotation);
+        },
+        "q: position too large: vertex positions of body '" + o.body + "' would overflow" +
+            (o.single_precision ? " float32" : ""));
+  // Outputs untouched on refusal.
+  EXPECT_EQ(positions_f32, std::vector<float>{ 42.0f });
+  EXPECT_EQ(rotation_f32, std::vector<float>{ 42.0f });
+  EXPECT_EQ(positions, std::vector<double>{ 42.0 });
+  EXPECT_EQ(rotation, std::vector<double>{ 42.0 });
+
+  // At the edge of the range: accepted, every value finite, as in
+  // get_vertex_jacobians. The ball's vertices (|p0| = 0.1 m) vanish in the
+  // rounding of a translation of FLT_MAX (float32) or DBL_MAX (double).
+  const float flt_max = std::numeric_limits<float>::max();
+  const double dbl_max = std::numeric_limits<double>::max();
+  queries.vertexRotationJacobians(current, "ball", {}, { 0.3, 0.2, 0.1, flt_max, -flt_max, 0 }, false, positions_f32,
+                                  rotation_f32);
+  ASSERT_EQ(positions_f32.size(), 3u * 114u);
+  EXPECT_EQ(positions_f32[0], flt_max);
+  EXPECT_EQ(positions_f32[1], -flt_max);
+  for (const std::vector<float>* field : { &positions_f32, &rotation_f32 })
+    for (float value : *field)
+      EXPECT_TRUE(std::isfinite(value));
+  queries.vertexRotationJacobians(current, "ball", {}, { 0.3, 0.2, 0.1, 0, -dbl_max, dbl_max }, false, positions,
+                                  rotation);
+  EXPECT_EQ(positions[1], -dbl_max);
+  EXPECT_EQ(positions[2], dbl_max);
+  for (const std::vector<double>* field : { &positions, &rotation })
+    for (double value : *field)
+      EXPECT_TRUE(std::isfinite(value));
+  std::vector<double> full_positions, full_jacobians;
+  queries.vertexJacobians(current, "ball", {}, { 0.3, 0.2, 0.1, 0, -dbl_max, dbl_max }, full_positions,
+                          full_jacobians);
+  EXPECT_EQ(positions, full_positions);
+  // The 1e38 m box at q = 0: vertices at 5e37 m, Jr entries up to 5e37 m.
+  wide.vertexRotationJacobians(wide.initialState(), "b", {}, { 0, 0, 0, 0, 0, 0 }, false, positions_f32,
+                               rotation_f32);
+  for (const std::vector<float>* field : { &positions_f32, &rotation_f32 })
+    for (float value : *field)
+      EXPECT_TRUE(std::isfinite(value));
 }
