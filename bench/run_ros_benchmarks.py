@@ -262,7 +262,8 @@ def main():
     parser.add_argument("--out", required=True)
     parser.add_argument("--budget", type=float, default=0.5, help="seconds per service measurement")
     parser.add_argument("--cpu-seconds", type=float, default=3.0)
-    parser.add_argument("--only", choices=["services", "scene"], default=None)
+    parser.add_argument("--only", choices=["services", "scene"], default=None,
+                        help="run only the service-level part or only the scene-scale part (default: both)")
     args = parser.parse_args()
     os.makedirs(args.out, exist_ok=True)
 

@@ -1,6 +1,7 @@
 #include "rigid_body_server.h"
 
 #include <algorithm>
+#include <cstring>
 
 #include <geometry_msgs/TransformStamped.h>
 #include <tf2_msgs/TFMessage.h>
@@ -12,22 +13,18 @@ namespace diff_rigid_body
 {
 namespace
 {
-geometry_msgs::TransformStamped toTransform(const Eigen::Isometry3d& pose, const std::string& parent,
-                                            const std::string& child, const ros::Time& stamp)
+// `pose` as a tf transform: its translation [m], and its rotation as a unit
+// quaternion (x, y, z, w).
+void setTransform(const Eigen::Isometry3d& pose, geometry_msgs::Transform& transform)
 {
-  geometry_msgs::TransformStamped transform;
-  transform.header.stamp = stamp;
-  transform.header.frame_id = parent;
-  transform.child_frame_id = child;
-  transform.transform.translation.x = pose.translation().x();
-  transform.transform.translation.y = pose.translation().y();
-  transform.transform.translation.z = pose.translation().z();
+  transform.translation.x = pose.translation().x();
+  transform.translation.y = pose.translation().y();
+  transform.translation.z = pose.translation().z();
   const Eigen::Quaterniond rotation(pose.linear());
-  transform.transform.rotation.x = rotation.x();
-  transform.transform.rotation.y = rotation.y();
-  transform.transform.rotation.z = rotation.z();
-  transform.transform.rotation.w = rotation.w();
-  return transform;
+  transform.rotation.x = rotation.x();
+  transform.rotation.y = rotation.y();
+  transform.rotation.z = rotation.z();
+  transform.rotation.w = rotation.w();
 }
 
 // Runs `work`; a core error becomes success=false with its message, so that
@@ -106,10 +103,11 @@ RigidBodyServer::RigidBodyServer(ros::NodeHandle& nh, ros::NodeHandle& private_n
   , state_file_(settings.state_file)
   , state_(std::make_shared<const SceneState>(initialState(queries_, state_file_)))
 {
-  (void)nh;
+  tf_subscriber_counter_ = nh.advertise<tf2_msgs::TFMessage>("/tf", 100);  // as tf2_ros::TransformBroadcaster
   states_publisher_ = private_nh.advertise<BodyStateArray>("states", 10, /*latch=*/true);
+  initOutgoingMessages(*state_);
   publishStaticLinks();
-  publishState(*state_, ros::Time::now());
+  publishState(ros::Time::now(), /*state_changed=*/true);
 
   services_.push_back(private_nh.advertiseService("get_bodies", &RigidBodyServer::getBodies, this));
   services_.push_back(private_nh.advertiseService("set_state", &RigidBodyServer::setState, this));
@@ -141,36 +139,75 @@ RigidBodyServer::StatePtr RigidBodyServer::snapshot() const
 void RigidBodyServer::applyStates(const std::vector<BodyState>& states)
 {
   std::lock_guard<std::mutex> write(write_mutex_);
-  auto next = std::make_shared<const SceneState>(queries_.applyStates(*snapshot(), toNamedStates(states)));
+  const StatePtr previous = snapshot();
+  auto next = std::make_shared<const SceneState>(queries_.applyStates(*previous, toNamedStates(states)));
   if (!state_file_.empty())
     writeStateFile(state_file_, queries_.scene(), *next);  // durable before it is visible or acknowledged
   {
     std::lock_guard<std::mutex> lock(snapshot_mutex_);
     state_ = next;
   }
-  publishState(*next, ros::Time::now());
+  updateOutgoingMessages(*previous, *next);
+  publishState(ros::Time::now(), /*state_changed=*/true);
 }
 
-void RigidBodyServer::publishState(const SceneState& state, const ros::Time& stamp)
+void RigidBodyServer::initOutgoingMessages(const SceneState& state)
 {
   const Scene& scene = queries_.scene();
-  std::vector<geometry_msgs::TransformStamped> transforms;
-  BodyStateArray states;
-  states.header.stamp = stamp;
-  states.header.frame_id = scene.fixed_frame;
+  first_transform_of_body_.assign(1, 0);
+  for (const SceneBody& body : scene.bodies)
+    first_transform_of_body_.push_back(first_transform_of_body_.back() + body.links.size());
+  body_transforms_.resize(first_transform_of_body_.back());
+  states_message_.header.frame_id = scene.fixed_frame;
+  states_message_.states.resize(scene.bodies.size());
   for (std::size_t i = 0; i < scene.bodies.size(); ++i)
   {
     const SceneBody& body = scene.bodies[i];
-    const Eigen::Isometry3d link_pose = linkPoseFromState(state[i], body.body.com_offset);
-    for (const LinkInBody& link : body.links)
-      transforms.push_back(toTransform(link_pose * link.pose_in_body_link, scene.fixed_frame, link.name, stamp));
-    BodyState body_state;
-    body_state.name = body.body.name;
-    std::copy(state[i].data(), state[i].data() + 6, body_state.q.begin());
-    states.states.push_back(std::move(body_state));
+    for (std::size_t l = 0; l < body.links.size(); ++l)
+    {
+      geometry_msgs::TransformStamped& transform = body_transforms_[first_transform_of_body_[i] + l];
+      transform.header.frame_id = scene.fixed_frame;
+      transform.child_frame_id = body.links[l].name;
+    }
+    states_message_.states[i].name = body.body.name;
+    writeBodyToOutgoingMessages(i, state[i]);
   }
-  tf_broadcaster_.sendTransform(transforms);  // one TFMessage for all frames
-  states_publisher_.publish(states);
+}
+
+void RigidBodyServer::updateOutgoingMessages(const SceneState& previous, const SceneState& next)
+{
+  for (std::size_t i = 0; i < next.size(); ++i)
+    if (std::memcmp(previous[i].data(), next[i].data(), sizeof(double) * 6) != 0)
+      writeBodyToOutgoingMessages(i, next[i]);
+}
+
+void RigidBodyServer::writeBodyToOutgoingMessages(std::size_t body_index, const Vector6<double>& q)
+{
+  const SceneBody& body = queries_.scene().bodies[body_index];
+  // Link l of the body: X_fixed_link = X_fixed_bodylink(q) * X_bodylink_link.
+  const Eigen::Isometry3d link_pose = linkPoseFromState(q, body.body.com_offset);
+  for (std::size_t l = 0; l < body.links.size(); ++l)
+    setTransform(link_pose * body.links[l].pose_in_body_link,
+                 body_transforms_[first_transform_of_body_[body_index] + l].transform);
+  std::copy(q.data(), q.data() + 6, states_message_.states[body_index].q.begin());
+}
+
+void RigidBodyServer::publishState(const ros::Time& stamp, bool state_changed)
+{
+  // Without a subscriber roscpp would drop the TFMessage unsent (see the header).
+  if (tf_subscriber_counter_.getNumSubscribers() > 0)
+  {
+    for (geometry_msgs::TransformStamped& transform : body_transforms_)
+      transform.header.stamp = stamp;
+    tf_broadcaster_.sendTransform(body_transforms_);  // one TFMessage for all frames
+  }
+  // ~states is latched, so roscpp serialises every publication even without
+  // a subscriber; an unchanged state is only re-sent to someone listening.
+  if (state_changed || states_publisher_.getNumSubscribers() > 0)
+  {
+    states_message_.header.stamp = stamp;
+    states_publisher_.publish(states_message_);
+  }
 }
 
 void RigidBodyServer::publishStaticLinks()
@@ -178,10 +215,15 @@ void RigidBodyServer::publishStaticLinks()
   const Scene& scene = queries_.scene();
   if (scene.static_links.empty())
     return;
-  std::vector<geometry_msgs::TransformStamped> transforms;
+  std::vector<geometry_msgs::TransformStamped> transforms(scene.static_links.size());
   const ros::Time stamp = ros::Time::now();
-  for (const StaticLink& link : scene.static_links)
-    transforms.push_back(toTransform(link.pose_in_fixed_frame, scene.fixed_frame, link.name, stamp));
+  for (std::size_t i = 0; i < scene.static_links.size(); ++i)
+  {
+    transforms[i].header.stamp = stamp;
+    transforms[i].header.frame_id = scene.fixed_frame;
+    transforms[i].child_frame_id = scene.static_links[i].name;
+    setTransform(scene.static_links[i].pose_in_fixed_frame, transforms[i].transform);
+  }
   static_broadcaster_.sendTransform(transforms);
 }
 
@@ -268,7 +310,7 @@ void RigidBodyServer::onTimer(const ros::TimerEvent&)
   // Under the write lock, so a periodic message never goes out after (and
   // overrides) a newer state published by a writer.
   std::lock_guard<std::mutex> write(write_mutex_);
-  publishState(*snapshot(), ros::Time::now());
+  publishState(ros::Time::now(), /*state_changed=*/false);
 }
 
 // --- Benchmarks / reduced transport (bench/): begin
@@ -276,46 +318,12 @@ bool RigidBodyServer::getVertexJacobiansCompact(GetVertexJacobiansCompact::Reque
                                                 GetVertexJacobiansCompact::Response& response)
 {
   return serve(response, "get_vertex_jacobians_compact", [&] {
-    // The checks and messages of get_vertex_jacobians (SceneQueries).
-    const std::size_t index = queries_.bodyIndex(request.body, "body");
-    const RigidBody& body = queries_.body(index);
-    const std::size_t available = static_cast<std::size_t>(body.vertices.cols());
-    const std::size_t count = request.vertices.empty() ? available : request.vertices.size();
-    if (count > RequestLimits::kMaxVertices)
-      throw InvalidArgumentError("vertices: expected at most " + std::to_string(RequestLimits::kMaxVertices) +
-                                 " vertices, got " + std::to_string(count) + " values");
-    for (std::size_t i = 0; i < request.vertices.size(); ++i)
-      if (request.vertices[i] >= available)
-        throw InvalidArgumentError("vertices[" + std::to_string(i) + "]: index " +
-                                   std::to_string(request.vertices[i]) + " out of range for body '" + body.name +
-                                   "' with " + std::to_string(available) + " vertices");
-    Vector6<double> q = (*snapshot())[index];
-    if (!request.q.empty())
-    {
-      if (request.q.size() != 6)
-        throw InvalidArgumentError("q: expected 6 values (or empty for the current state), got " +
-                                   std::to_string(request.q.size()) + " values");
-      requireFinite(request.q.data(), 6, "q");
-      q = Eigen::Map<const Vector6<double>>(request.q.data());
-    }
-    const BodyPose<double> pose(q);
-    auto fill = [&](auto& positions, auto& jacobians) {
-      positions.resize(3 * count);
-      if (!request.positions_only)
-        jacobians.resize(9 * count);
-      vertexPositionsAndRotationJacobians(pose, body.vertices, request.vertices, positions.data(),
-                                          request.positions_only ? nullptr : jacobians.data());
-      // Finite inputs can still overflow (a far position, or float32).
-      for (const auto* field : { &positions, &jacobians })
-        for (const auto value : *field)
-          if (!std::isfinite(value))
-            throw InvalidArgumentError("q: results of body '" + body.name + "' overflow" +
-                                       (request.single_precision ? " float32" : ""));
-    };
     if (request.single_precision)
-      fill(response.positions_f32, response.rotation_jacobians_f32);
+      queries_.vertexRotationJacobians(*snapshot(), request.body, request.vertices, request.q, request.positions_only,
+                                       response.positions_f32, response.rotation_jacobians_f32);
     else
-      fill(response.positions, response.rotation_jacobians);
+      queries_.vertexRotationJacobians(*snapshot(), request.body, request.vertices, request.q, request.positions_only,
+                                       response.positions, response.rotation_jacobians);
   });
 }
 

@@ -12,6 +12,16 @@
 // Durable state (~state_file): a writer saves the new state (temp file,
 // fsync, rename, fsync of the folder) before it swaps the snapshot in, so an
 // acknowledged change survives a crash; a failed save refuses the change.
+//
+// Publication (tf and ~states) happens under the writer mutex, at
+// ~publish_rate and after every accepted change, from messages kept equal to
+// the current state: frame ids and names are written once at start, a state
+// change rewrites the entries of the bodies whose q changed, and a periodic
+// tick only restamps. A tick therefore costs O(links) stores plus what
+// tf2_ros and roscpp do with the messages, with no quaternion or string work.
+// roscpp drops a non-latched message that has no subscriber, so a tick skips
+// /tf (the restamp and tf2_ros's copy into a TFMessage) while /tf has no
+// subscriber: the traffic is the same, and a new subscriber gets the next tick.
 #pragma once
 
 #include <memory>
@@ -33,6 +43,7 @@
 #include <diff_rigid_body/Echo.h>
 #include <diff_rigid_body/GetVertexJacobiansCompact.h>
 #include <diff_rigid_body/Ping.h>
+#include <geometry_msgs/TransformStamped.h>
 
 #include "diff_rigid_body/scene_queries.h"
 
@@ -59,7 +70,19 @@ private:
   StatePtr snapshot() const;
   /// Validates and applies named states (all or nothing), then publishes them.
   void applyStates(const std::vector<BodyState>& states);
-  void publishState(const SceneState& state, const ros::Time& stamp);
+  /// Writes the frame ids and names of the outgoing messages, and their
+  /// transforms and q from `state` (once, at start).
+  void initOutgoingMessages(const SceneState& state);
+  /// Rewrites the transforms and q of the bodies whose q differs (bitwise)
+  /// between `previous` and `next`.
+  void updateOutgoingMessages(const SceneState& previous, const SceneState& next);
+  void writeBodyToOutgoingMessages(std::size_t body_index, const Vector6<double>& q);
+  /// Restamps the outgoing messages and publishes them: all body link frames
+  /// on /tf in one message (when /tf has a subscriber), and the states on
+  /// ~states. Without a ~states subscriber, ~states goes out only if
+  /// `state_changed`; its latched message then still holds the current state
+  /// (every change is published), stamped at or after that change.
+  void publishState(const ros::Time& stamp, bool state_changed);
   void publishStaticLinks();
 
   bool getBodies(GetBodies::Request& request, GetBodies::Response& response);
@@ -82,7 +105,17 @@ private:
   std::mutex write_mutex_;             ///< serialises state changes and their publication
   StatePtr state_;
 
+  // The outgoing messages, equal to *state_ and guarded by write_mutex_.
+  /// Every link of every body, in body order, then link order within a body.
+  std::vector<geometry_msgs::TransformStamped> body_transforms_;
+  /// Body i's links are body_transforms_[first_transform_of_body_[i], first_transform_of_body_[i + 1]).
+  std::vector<std::size_t> first_transform_of_body_;
+  BodyStateArray states_message_;
+
   tf2_ros::TransformBroadcaster tf_broadcaster_;
+  /// A second handle on the broadcaster's /tf publication (roscpp keeps one
+  /// publication per topic and process), used only for getNumSubscribers().
+  ros::Publisher tf_subscriber_counter_;
   tf2_ros::StaticTransformBroadcaster static_broadcaster_;
   ros::Publisher states_publisher_;
   ros::Subscriber set_states_subscriber_;
