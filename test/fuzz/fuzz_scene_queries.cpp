@@ -3,8 +3,8 @@
 // with a merged link; no files are read).
 //
 // The input is decoded with FuzzedDataProvider into up to 8 requests, each
-// one of set_state, get_state, get_mass_matrix, get_vertex_jacobians and
-// backprop, with fuzzed body names (known, unknown, empty, repeated, random
+// one of set_state, get_state, get_mass_matrix, get_vertex_jacobians, its
+// compact variant (double and float32) and backprop, with fuzzed body names (known, unknown, empty, repeated, random
 // bytes), q and gradients (any double: NaN, +-Inf, subnormals, +-0, huge,
 // or plain values), vertex indices (in range or any uint32) and sizes.
 // set_state changes the current state that later requests see, so queries
@@ -13,6 +13,7 @@
 // Invariants: a request either throws InvalidArgumentError and leaves its
 // outputs untouched, or answers with the documented sizes and only finite
 // numbers; set_state is all or nothing and stores q bit for bit.
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
@@ -250,6 +251,38 @@ void getVertexJacobians(FuzzedDataProvider& in, const drb::SceneState& current)
   requireAllFinite(jacobians.data(), jacobians.size(), "jacobians");
 }
 
+/// ~get_vertex_jacobians_compact: positions and the rotation block, in
+/// double or float32, or positions only.
+template <typename Out>
+void vertexRotationJacobians(FuzzedDataProvider& in, const drb::SceneState& current)
+{
+  const std::string body = fuzzedName(in);
+  const std::vector<std::uint32_t> vertices = fuzzedVertices(in);
+  const std::vector<double> q = fuzzedQ(in);
+  const bool positions_only = in.ConsumeBool();
+  std::vector<Out> positions{ Out(42) }, rotation_jacobians{ Out(43) };
+  try
+  {
+    queries().vertexRotationJacobians<Out>(current, body, vertices, q, positions_only, positions,
+                                           rotation_jacobians);
+  }
+  catch (const drb::InvalidArgumentError&)
+  {
+    require(positions == std::vector<Out>{ Out(42) } && rotation_jacobians == std::vector<Out>{ Out(43) },
+            "get_vertex_jacobians_compact: a refused request wrote its outputs");
+    return;
+  }
+  const int index = queries().scene().findBody(body);
+  require(index >= 0, "get_vertex_jacobians_compact accepted an unknown body");
+  const std::size_t count =
+      vertices.empty() ? static_cast<std::size_t>(queries().body(index).vertices.cols()) : vertices.size();
+  require(positions.size() == 3 * count && rotation_jacobians.size() == (positions_only ? 0 : 9 * count),
+          "get_vertex_jacobians_compact: wrong sizes");
+  for (const std::vector<Out>* values : { &positions, &rotation_jacobians })
+    for (std::size_t i = 0; i < values->size(); ++i)
+      require(std::isfinite((*values)[i]), "get_vertex_jacobians_compact: an answer is not finite");
+}
+
 void backprop(FuzzedDataProvider& in, const drb::SceneState& current)
 {
   const std::string body = fuzzedName(in);
@@ -285,7 +318,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   drb::SceneState current = queries().initialState();
   for (int request = 0; request < 8 && in.remaining_bytes() > 0; ++request)
   {
-    switch (in.ConsumeIntegralInRange<int>(0, 4))
+    switch (in.ConsumeIntegralInRange<int>(0, 6))
     {
       case 0:
         setState(in, current);
@@ -298,6 +331,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         break;
       case 3:
         getVertexJacobians(in, current);
+        break;
+      case 4:
+        vertexRotationJacobians<double>(in, current);
+        break;
+      case 5:
+        vertexRotationJacobians<float>(in, current);
         break;
       default:
         backprop(in, current);
