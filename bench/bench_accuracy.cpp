@@ -266,6 +266,7 @@ int main(int argc, char** argv)
     }
     const drb::Matrix3X<mpreal> vertices_mp = vertices.cast<mpreal>();
     std::vector<mpreal> g_mp(g.begin(), g.end());
+    const drb::VertexColumns<double> columns = vertices.transpose();
     for (const TaggedState& s : states)
     {
       const drb::BodyPose<mpreal> pose_mp(VectorMp6(s.q.cast<mpreal>()));
@@ -278,6 +279,7 @@ int main(int argc, char** argv)
       };
       const drb::BodyPose<double> pose(s.q);
       check("ours_double", drb::backpropagateVertexGradients(pose, vertices, {}, g.data()));
+      check("ours_columns", drb::backpropagateVertexGradients(pose, columns, g.data()));
       check("form_J_and_multiply", backpropFormJ(pose, vertices, g.data()));
       check("J_buffer_then_multiply", backpropViaBuffer(pose, vertices, g.data(), buffer.data()));
     }

@@ -17,6 +17,7 @@
 #include <Eigen/Core>
 
 #include "diff_rigid_body/triangle_mesh.h"
+#include "diff_rigid_body/vertex_columns.h"
 #include "diff_rigid_body/vertex_jacobian.h"
 
 namespace drb_bench

@@ -63,6 +63,7 @@ struct Workspace
 {
   std::string name;
   Matrix3Xd vertices;
+  drb::VertexColumns<double> columns;  ///< the same vertices by coordinate (as the node keeps them)
   drb::Matrix3X<float> vertices_f;
   std::vector<double> jacobians, positions, gradients, memcpy_source;
   std::vector<float> jacobians_f;
@@ -70,6 +71,7 @@ struct Workspace
   Workspace(std::string n, Matrix3Xd v) : name(std::move(n)), vertices(std::move(v))
   {
     const std::size_t count = static_cast<std::size_t>(vertices.cols());
+    columns = vertices.transpose();
     vertices_f = vertices.cast<float>();
     jacobians.assign(18 * count, 1.0);
     positions.assign(3 * count, 1.0);
@@ -314,6 +316,23 @@ void registerJacobians()
 
 void registerBackprop()
 {
+  // The per-call part every method pays: q -> R, T (three sin/cos pairs).
+  benchmark::RegisterBenchmark("backprop_fixed/body_pose", [](benchmark::State& st) {
+    perState(st, 1, [&](const Vector6d& q) {
+      const drb::BodyPose<double> pose(q);
+      benchmark::DoNotOptimize(&pose);
+    });
+  });
+  // Ours with no vertex: the pose, the SIMD set-up and lane reductions, and
+  // dL/dq from the sums; what a call costs beyond its vertices.
+  benchmark::RegisterBenchmark("backprop_fixed/ours_columns_no_vertices", [](benchmark::State& st) {
+    const drb::VertexColumns<double> none(0, 3);
+    perState(st, 1, [&](const Vector6d& q) {
+      const drb::BodyPose<double> pose(q);
+      Vector6d g = drb::backpropagateVertexGradients(pose, none, nullptr);
+      benchmark::DoNotOptimize(g.data());
+    });
+  });
   for (std::size_t index = 0; index < workspaces().size(); ++index)
   {
     Workspace* ws = workspaces()[index].get();
@@ -326,6 +345,21 @@ void registerBackprop()
         benchmark::DoNotOptimize(g.data());
       });
     });
+    benchmark::RegisterBenchmark((prefix + "ours_columns").c_str(), [ws, n](benchmark::State& st) {
+      perState(st, n, [&](const Vector6d& q) {
+        const drb::BodyPose<double> pose(q);
+        Vector6d g = drb::backpropagateVertexGradients(pose, ws->columns, ws->gradients.data());
+        benchmark::DoNotOptimize(g.data());
+      });
+    });
+    // Wall time: CPU time would count the calling thread only.
+    benchmark::RegisterBenchmark((prefix + "ours_columns_2_threads").c_str(), [ws, n](benchmark::State& st) {
+      perState(st, n, [&](const Vector6d& q) {
+        const drb::BodyPose<double> pose(q);
+        Vector6d g = drb::backpropagateVertexGradients(pose, ws->columns, ws->gradients.data(), 2);
+        benchmark::DoNotOptimize(g.data());
+      });
+    })->UseRealTime();
     benchmark::RegisterBenchmark((prefix + "form_J_and_multiply").c_str(), [ws, n](benchmark::State& st) {
       perState(st, n, [&](const Vector6d& q) {
         const drb::BodyPose<double> pose(q);

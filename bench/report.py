@@ -36,7 +36,7 @@ def kernel_table(kernels):
     for b in kernels["benchmarks"]:
         if b.get("run_type") != "aggregate" or b.get("aggregate_name") != "median":
             continue
-        name = re.sub(r"/min_time:[0-9.]+", "", b["run_name"])
+        name = re.sub(r"/min_time:[0-9.]+|/real_time$", "", b["run_name"])
         items = b.get("items", 1.0)
         scale = {"ns": 1.0, "us": 1e3, "ms": 1e6, "s": 1e9}[b.get("time_unit", "ns")]
         table[name] = {"cpu": b["cpu_time"] * scale / items, "real": b["real_time"] * scale / items, "items": items}
@@ -289,33 +289,54 @@ def section_jacobians(k, acc, targets):
 
 def section_backprop(k, acc, targets):
     errors = acc["backprop"]
+    pose = k.get("backprop_fixed/body_pose", {}).get("cpu")
     text = ["## 3. Backprop (vector-Jacobian product)",
             "",
-            "dL/dq = Σ J_iᵀ g_i. Ours never forms J: one 3×3 rank-1 update per vertex, four vertices per AVX2 "
-            "register with FMA when the CPU has them (chosen at run time; the build stays at the x86-64 "
-            "baseline), else two per SSE2 register. Baselines: J formed per vertex in registers and multiplied; and J written for all "
-            "vertices (as `get_vertex_jacobians` returns it) then multiplied. Errors relative to the sum of the "
-            "terms' magnitudes (Σ|p0_i||g_i| for dL/dr, Σ|g_i| for dL/dt).",
+            "dL/dq = Σ J_iᵀ g_i. Ours never forms J: W = Σ g_i p0_iᵀ and Σ g_i, then one 3×3 product "
+            "(`backpropFromSums`). **By coordinate** (`vertex_columns.h`, what the node runs for a request of all "
+            "vertices): the body's vertices are kept as x, y, z arrays made once at load (24 B per vertex), so one "
+            "load holds 8 vertices' x (AVX-512) or 4 (AVX2 + FMA), chosen at run time; only the client's gradients are "
+            "transposed in registers. **As stored** (3×N, `vertex_jacobian.h`, used for index lists): both "
+            "operands transposed, 4 vertices per AVX2 register. **2 threads**: the by-coordinate sum cut into two "
+            "contiguous chunks (only for ≥ 2 × 65,536 vertices; wall time, since CPU time counts one thread). "
+            "Baselines: J formed per vertex in registers and multiplied; and J written for all vertices (as "
+            "`get_vertex_jacobians` returns it) then multiplied. Times per vertex, each call over the whole set at a "
+            "new state. Errors relative to the sum of the terms' magnitudes (Σ|p0_i||g_i| for dL/dr, Σ|g_i| for "
+            "dL/dt).",
             ""]
     rows = []
     ratios = []
     for s in vertex_sets(k):
-        t = k.get(f"backprop/{s}/ours_double", {}).get("cpu")
-        f = k.get(f"backprop/{s}/form_J_and_multiply", {}).get("cpu")
-        b = k.get(f"backprop/{s}/J_buffer_then_multiply", {}).get("cpu")
+        t = k.get(f"backprop/{s}/ours_columns", {}).get("cpu")
         if t is None:
             continue
-        items = int(k[f"backprop/{s}/ours_double"]["items"])
-        rows.append([f"{s} ({items:,})", fmt_time(t), fmt_time(f), fmt_ratio(f / t) if f else "n/a", fmt_time(b),
-                     fmt_ratio(b / t) if b else "n/a"])
-        ratios.append((s, f / t if f else None, b / t if b else None))
-    text.append(md_table(["vertex set", "ours / vertex", "J in registers, multiply", "speed-up",
-                          "J buffer, then multiply", "speed-up"], rows))
-    text += ["", "Max rel. error: ours " + fmt_err(max_error(errors, "ours_double")) + ", J in registers " +
+        t2 = k.get(f"backprop/{s}/ours_columns_2_threads", {}).get("real")
+        t_aos = k.get(f"backprop/{s}/ours_double", {}).get("cpu")
+        f = k.get(f"backprop/{s}/form_J_and_multiply", {}).get("cpu")
+        b = k.get(f"backprop/{s}/J_buffer_then_multiply", {}).get("cpu")
+        items = int(k[f"backprop/{s}/ours_columns"]["items"])
+        rows.append([f"{s} ({items:,})", fmt_time(t), fmt_time(t2) if t2 else "n/a",
+                     fmt_time(t_aos) if t_aos else "n/a", fmt_time(f), fmt_ratio(f / t) if f else "n/a",
+                     fmt_time(b), fmt_ratio(b / t) if b else "n/a"])
+        ratios.append((s, items, f / t if f else None, b / t if b else None, b * items if b else None))
+    text.append(md_table(["vertex set", "ours, by coordinate", "… 2 threads (wall)", "ours, as stored (3×N)",
+                          "J in registers, multiply", "speed-up", "J buffer, then multiply", "speed-up"], rows))
+    text += ["", "Max rel. error: ours by coordinate " + fmt_err(max_error(errors, "ours_columns")) +
+             ", as stored " + fmt_err(max_error(errors, "ours_double")) + ", J in registers " +
              fmt_err(max_error(errors, "form_J_and_multiply")) + ", J buffer " +
              fmt_err(max_error(errors, "J_buffer_then_multiply")) + "."]
-    for s, regs, buf in ratios:
-        items = int(k[f"backprop/{s}/ours_double"]["items"])
+    fixed = k.get("backprop_fixed/ours_columns_no_vertices", {}).get("cpu")
+    if pose and fixed:
+        text += ["", f"Per call, beyond its vertices, ours costs {fmt_time(fixed)} (a call with no vertex): the "
+                 f"pose q → R, T (`BodyPose`, three sin/cos pairs, {fmt_time(pose)}, which the baselines pay too), "
+                 "the SIMD set-up and lane reductions, and dL/dq from the sums. However fast the per-vertex loop, a "
+                 "call's speed-up cannot exceed (baseline's call) ÷ (this fixed part):"]
+        bounds = [[f"{s} ({items:,})", fmt_time(call), fmt_ratio(call / fixed)]
+                  for s, items, _, _, call in ratios if call and call / fixed < 1000]
+        if bounds:
+            text += ["", md_table(["vertex set", "J buffer, then multiply, per call",
+                                   "speed-up bound from ours' fixed part"], bounds)]
+    for s, items, regs, buf, _ in ratios:
         if regs is None or buf is None:
             continue
         if regs >= 10:
@@ -519,6 +540,7 @@ def main():
     plot_kernels(k, acc, args.docs)
 
     info = machine(args.workspace, kernels_json, args.repo)
+    repetitions = max((b.get("repetitions", 1) for b in kernels_json["benchmarks"]), default=1)
     now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     head = ["# Benchmarks: speed against error",
             "",
@@ -531,8 +553,9 @@ def main():
             "```",
             "",
             "Every figure is measured in the same run as the peers it is compared with: KDL "
-            "(`liborocos-kdl-dev`) and MuJoCo (`libmujoco-dev`). Kernel times are medians over 3 repetitions "
-            "of Google Benchmark's **CPU time** per operation (robust on a shared machine; the JSON in the "
+            "(`liborocos-kdl-dev`) and MuJoCo (`libmujoco-dev`). Kernel times are medians over "
+            f"{repetitions} repetitions, run in random interleaved order (a slow phase of the machine "
+            "lands on every method alike), of Google Benchmark's **CPU time** per operation (robust on a shared machine; the JSON in the "
             "results folder also has wall time). Errors are maxima of the relative error against a 256-bit "
             "MPFR reference (our scalar-templated kernels evaluated in `mpfr::mpreal`) over the hard cases of "
             "math.md: random states, gimbal lock θ = ±π/2 and ±π/2 ± 10⁻ᵏ (k = 1…16), angles up to 1e6 rad, "
