@@ -16,7 +16,7 @@
 //
 // Large meshes can be split over threads: the vertices are cut into
 // contiguous chunks whose sums are added in chunk order, so for a given
-// vertex count and thread count the result is always the same.
+// vertex count, thread count and CPU path the result is always the same.
 #pragma once
 
 #include <algorithm>
@@ -77,8 +77,8 @@ inline void addVertexGradientsScalar(const double* x, const double* y, const dou
 /// the hardware prefetcher alone, bench/).
 constexpr std::size_t kPrefetchVertices = 128;
 
-/// Requests the lines of vertex n + kPrefetchVertices (24 B of gradient,
-/// 8 B of each coordinate) unless that is within kPrefetchVertices + 8 of
+/// Requests the lines holding vertices n + kPrefetchVertices .. + 7 (three
+/// lines of gradients, one line of each coordinate) unless that is within kPrefetchVertices + 8 of
 /// the end. always_inline matters: GCC deletes calls to a function that only
 /// prefetches (it counts as free of side effects) unless it is inlined first.
 __attribute__((always_inline)) inline void prefetchVertex(const double* x, const double* y, const double* z,
@@ -258,7 +258,7 @@ inline VertexGradientSums<double> sumVertexGradients(const VertexColumns<double>
     {
       helpers.emplace_back(run, c);
     }
-    catch (const std::system_error&)  // no thread available: do the chunk here
+    catch (...)  // no thread available (system_error, bad_alloc): do the chunk here
     {
       run(c);
     }
