@@ -1,5 +1,5 @@
-// The node's topics: ~states is published (latched, on every change and at
-// the publish rate); ~set_states applies a valid BodyStateArray like
+// The node's topics: ~states is published (latched, on every change, and at
+// the publish rate while it has a subscriber); ~set_states applies a valid BodyStateArray like
 // set_state and drops an invalid one whole, with a warning (on /rosout)
 // that names the problem.
 //
