@@ -9,6 +9,11 @@ against a running rigid_body_server (the default scene).
    trajectory: one batched get_mass_matrix call against K calls.
 
 Usage: demo_client.py [--body knot] [--noise 0.001] [--configurations 1000]
+
+Exits 1 unless every fit converged: without noise each fit must recover the
+hidden pose to EXACT_ANGLE [rad] and EXACT_POSITION [m]; with noise the two
+fits must agree with each other to AGREE_ANGLE [rad] and AGREE_POSITION [m].
+On success the last line is "demo: all fits converged".
 """
 import argparse
 import sys
@@ -20,6 +25,8 @@ from diff_rigid_body.client import DiffRigidBodyError, RigidBodyClient
 from diff_rigid_body import pose_fitting, trajectory_energy
 
 Q_HIDDEN = np.array([0.3, -0.4, 1.1, 0.05, -0.1, 0.6])  # the pose to recover
+EXACT_ANGLE, EXACT_POSITION = 1e-8, 1e-8  # [rad], [m]: noise-free fit vs Q_HIDDEN
+AGREE_ANGLE, AGREE_POSITION = 1e-6, 1e-6  # [rad], [m]: noisy fits, one vs the other
 
 
 def print_scene(client):
@@ -33,13 +40,16 @@ def print_scene(client):
 
 
 def pose_fitting_example(client, body, noises):
+    """Prints one row per fit; returns the list of failures (empty: all converged)."""
     print('\n1. Pose fitting of %r: hidden q = %s' % (body, np.array2string(Q_HIDDEN, precision=3)))
     print('   %-26s %7s %6s %6s %12s %13s %13s %9s' % (
         'solver', 'noise', 'iters', 'calls', 'rms resid', 'angle error', 'pos error', 'time'))
+    failures = []
     for noise in noises:
         target, q_start = pose_fitting.make_problem(client, body, Q_HIDDEN, noise=noise, seed=3)
         angle, distance = pose_fitting.pose_error(q_start, Q_HIDDEN)
         print('   start: %.1f deg and %.3f m away (noise %g m)' % (np.degrees(angle), distance, noise))
+        fitted = []
         for label, fit in (('Gauss-Newton (jacobians)', pose_fitting.fit_gauss_newton),
                            ('L-BFGS (backprop)', pose_fitting.fit_lbfgs)):
             result = fit(client, body, target, q_start)
@@ -47,6 +57,19 @@ def pose_fitting_example(client, body, noises):
             print('   %-26s %7g %6d %6d %10.3e m %9.3e rad %11.3e m %7.3f s%s' % (
                 label, noise, result.iterations, result.evaluations, result.residual_rms, angle, distance,
                 result.wall_time, '' if result.converged else '  (NOT CONVERGED: %s)' % result.reason))
+            if not result.converged:
+                failures.append('%s, noise %g m: not converged (%s)' % (label, noise, result.reason))
+            elif noise == 0.0 and not (angle < EXACT_ANGLE and distance < EXACT_POSITION):
+                failures.append('%s, no noise: %.3e rad and %.3e m from the hidden pose (tolerance %g rad, %g m)'
+                                % (label, angle, distance, EXACT_ANGLE, EXACT_POSITION))
+            fitted.append(result.q)
+        if noise != 0.0:
+            angle, distance = pose_fitting.pose_error(fitted[0], fitted[1])
+            print('   the two fits differ by %.3e rad and %.3e m' % (angle, distance))
+            if not (angle < AGREE_ANGLE and distance < AGREE_POSITION):
+                failures.append('noise %g m: the two fits differ by %.3e rad and %.3e m (tolerance %g rad, %g m)'
+                                % (noise, angle, distance, AGREE_ANGLE, AGREE_POSITION))
+    return failures
 
 
 def trajectory_example(client, bodies, count):
@@ -79,12 +102,17 @@ def main():
 
     client = RigidBodyClient(args.server).connect()  # persistent connections, opened before any timing
     bodies = print_scene(client)
-    pose_fitting_example(client, args.body, [0.0, args.noise])
+    failures = pose_fitting_example(client, args.body, [0.0, args.noise])
     trajectory_example(client, bodies, args.configurations)
     try:
         client.vertex_jacobians('no_such_body')
     except DiffRigidBodyError as e:
         print('\nA refused request raises DiffRigidBodyError: %s' % e)
+    for failure in failures:
+        print('demo: FAILED: %s' % failure)
+    if failures:
+        return 1
+    print('demo: all fits converged')
     return 0
 
 

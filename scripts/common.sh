@@ -70,6 +70,10 @@ drb_build() {
         "the package again through src/diff_rigid_body (file system loop); choose a path outside ${DRB_REPO}"
       return 1 ;;
   esac
+  if [[ -d "${DRB_REPO}/.build/ws/src" ]]; then
+    drb_log "warning: ${DRB_REPO}/.build holds a workspace of an older version (inside the checkout);" \
+      "remove it (rm -rf .build): rospack and rosrun follow its src/ link back into the checkout"
+  fi
   if [[ "${DRB_SKIP_BUILD:-0}" == 1 ]]; then
     if [[ ! -f "${DRB_WORKSPACE}/devel/setup.bash" ]]; then
       drb_log "DRB_SKIP_BUILD=1 but ${DRB_WORKSPACE} has not been built (no devel/setup.bash)"
