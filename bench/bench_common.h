@@ -1,13 +1,15 @@
-// Shared inputs of the benchmarks: the state set with the hard cases of
-// math.md, bodies with extreme masses and inertias, vertex sets and meshes
-// (the shared bunny/armadillo when present, generated stand-ins of the same
-// size otherwise). Fixed seeds: every run sees the same inputs.
+// Common inputs of the benchmarks: the state set with the hard cases of
+// docs/derivation.md ("Hard cases"), bodies with extreme masses and
+// inertias, vertex sets and meshes (the Stanford bunny and armadillo of
+// test/meshes/stanford, generated spheres for 10^2 and 10^6 vertices).
+// Fixed seeds: every run sees the same inputs.
 #pragma once
 
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -261,33 +263,31 @@ inline bool readObj(const std::string& path, drb::TriangleMesh* mesh)
   return true;
 }
 
-/// A named mesh: `name` from DRB_SHARED_MESH_DIR (the shared bunny or
-/// armadillo) when present, else a generated closed stand-in of the same
-/// vertex count, named "<name>-standin".
+/// A named mesh read from this repository's test/meshes/stanford (the
+/// Stanford bunny or armadillo; see the README.md there).
 struct NamedMesh
 {
   std::string name;
   drb::TriangleMesh mesh;
-  bool generated = false;
 };
 
-inline NamedMesh sharedOrStandIn(const std::string& name, std::size_t vertex_count)
+/// `name`.obj from DRB_MESH_DIR (set by CMakeLists.txt to
+/// <repo>/test/meshes/stanford). The meshes are part of the repository, so a
+/// missing one is an error: exits with status 2 and a message.
+inline NamedMesh stanfordMesh(const std::string& name)
 {
-  NamedMesh out;
-  const char* env = std::getenv("DRB_SHARED_MESH_DIR");
-  std::string dir = env ? env : "";
-#ifdef DRB_SHARED_MESH_DIR
-  if (dir.empty())
-    dir = DRB_SHARED_MESH_DIR;
+#ifdef DRB_MESH_DIR
+  const std::string path = std::string(DRB_MESH_DIR) + "/" + name + ".obj";
+#else
+  const std::string path = "(DRB_MESH_DIR not defined by the build)/" + name + ".obj";
 #endif
-  if (!dir.empty() && readObj(dir + "/" + name + ".obj", &out.mesh))
+  NamedMesh out;
+  out.name = name;
+  if (!readObj(path, &out.mesh))
   {
-    out.name = name;
-    return out;
+    std::fprintf(stderr, "benchmark mesh %s is missing or unreadable\n", path.c_str());
+    std::exit(2);
   }
-  out.name = name + "-standin";
-  out.mesh = bumpySphere(vertex_count);
-  out.generated = true;
   return out;
 }
 
@@ -303,9 +303,9 @@ inline std::vector<VertexSet> jacobianVertexSets()
 {
   std::vector<VertexSet> sets;
   sets.push_back({ "generated-1e2", bumpySphere(100).vertices });
-  NamedMesh bunny = sharedOrStandIn("bunny", 13934);
+  NamedMesh bunny = stanfordMesh("bunny");
   sets.push_back({ bunny.name, bunny.mesh.vertices });
-  NamedMesh armadillo = sharedOrStandIn("armadillo", 25002);
+  NamedMesh armadillo = stanfordMesh("armadillo");
   sets.push_back({ armadillo.name, armadillo.mesh.vertices });
   sets.push_back({ "generated-1e6", bumpySphere(1000000).vertices });
   return sets;

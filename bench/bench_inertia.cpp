@@ -1,8 +1,7 @@
-// Inertia, speed against error: the seed's particle sum (eq. 17,
-// particleMassProperties) at N = 10^2 .. 10^6 samples against the exact
-// polyhedral integral (meshMassProperties), on the shared bunny and
-// armadillo, or generated closed stand-ins of the same size when
-// ../shared/meshes is absent. Writes JSON to argv[1] (or stdout).
+// Inertia, speed against error: the particle sum (particleMassProperties;
+// docs/derivation.md, "Inertia") at N = 10^2 .. 10^6 samples against the
+// exact polyhedral integral (meshMassProperties), on the Stanford bunny and
+// armadillo of test/meshes/stanford. Writes JSON to argv[1] (or stdout).
 //
 // Errors (density 1000 kg/m^3; the mesh in its own frame):
 //   mass     |m_N - m| / m
@@ -49,19 +48,19 @@ int main(int argc, char** argv)
     return 1;
   }
   std::fprintf(out, "{\"density\": %g, \"meshes\": [\n", density);
-  const std::vector<std::pair<std::string, std::size_t>> names = { { "bunny", 13934 }, { "armadillo", 25002 } };
+  const std::vector<std::string> names = { "bunny", "armadillo" };
   for (std::size_t m = 0; m < names.size(); ++m)
   {
-    const NamedMesh named = sharedOrStandIn(names[m].first, names[m].second);
+    const NamedMesh named = stanfordMesh(names[m]);
     const drb::TriangleMesh& mesh = named.mesh;
     drb::MassProperties exact;
     const double exact_time = timeIt([&] { exact = drb::meshMassProperties(density, mesh, named.name); }, budget);
     const double diagonal = (mesh.vertices.rowwise().maxCoeff() - mesh.vertices.rowwise().minCoeff()).norm();
     const double inertia_scale = exact.inertia.cwiseAbs().maxCoeff();
     std::fprintf(out,
-                 "  {\"name\": \"%s\", \"generated\": %s, \"vertices\": %ld, \"triangles\": %zu, "
+                 "  {\"name\": \"%s\", \"vertices\": %ld, \"triangles\": %zu, "
                  "\"exact_seconds\": %.6g, \"mass\": %.17g, \"points\": [\n",
-                 named.name.c_str(), named.generated ? "true" : "false", static_cast<long>(mesh.vertices.cols()),
+                 named.name.c_str(), static_cast<long>(mesh.vertices.cols()),
                  mesh.triangles.size(), exact_time, exact.mass);
     const std::vector<std::size_t> targets = { 100, 316, 1000, 3162, 10000, 31623, 100000, 316228, 1000000 };
     for (std::size_t k = 0; k < targets.size(); ++k)

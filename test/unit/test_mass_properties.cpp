@@ -6,6 +6,7 @@
 //   particle sum on a mesh      <- brute-force eq. (17) over the same grid with a
 //                                  half-space inside test; converges to the mesh integral
 //   bunny                       <- exact integral vs 1e6 particles
+// eq. (17) is the seed's particle sum; the formulas are in docs/derivation.md ("Inertia").
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -838,12 +839,11 @@ TEST(MassPropertiesParticles, ConvergesToMeshIntegral)
 
 TEST(MassPropertiesParticles, BunnyExactIntegralAgainstMillionParticles)
 {
-  const std::string path = std::string(DRB_SHARED_MESH_DIR) + "/bunny.obj";
-  if (!std::ifstream(path).good())
-    GTEST_SKIP() << "shared mesh " << path << " is absent; the bunny check needs it";
+  // The Stanford bunny (closed, 27864 triangles); provenance in test/meshes/stanford/README.md.
+  const std::string path = DRB_TEST_DATA_DIR "/meshes/stanford/bunny.obj";
   TriangleMesh bunny;
   std::string error;
-  ASSERT_TRUE(readObj(path, &bunny, &error)) << error;
+  ASSERT_TRUE(readObj(path, &bunny, &error)) << "the bunny fixture is part of the repository: " << error;
   ASSERT_EQ(bunny.triangles.size(), 27864u);
   // Tolerances. The grid's staircase error is ~ sqrt(A) h^2 / V relative
   // (A/h^2 boundary cells, independent errors): with A = 0.0572 m^2,
