@@ -1,7 +1,8 @@
 // Maximum relative error of every benchmarked method against a 256-bit MPFR
 // reference (our scalar-templated kernels evaluated in mpfr::mpreal, which
 // test_core checks against an independent mpreal evaluation), over the
-// hard-case state set of math.md. Writes JSON to argv[1] (or stdout).
+// hard-case state set of docs/derivation.md ("Hard cases"). Writes JSON to
+// argv[1] (or stdout).
 //
 // Error measures (the difference is taken in 256 bits, then rounded):
 //   mass matrix  max over the four 3x3 blocks of max|dM| / s, with s the

@@ -1,6 +1,7 @@
 // Mass properties: composites by the parallel-axis theorem, closed-form
 // primitives, the exact polyhedral integral of a closed mesh, and the seed
-// paper's particle sum (eq. 17) over grid samples inside a mesh.
+// paper's particle sum (eq. 17) over grid samples inside a mesh. Formulas:
+// docs/derivation.md, "Inertia".
 //
 // Conventions (all functions):
 //   MassProperties.mass     [kg]

@@ -5,7 +5,7 @@ answers (K, n, 6, 6) without touching the node's state; the same energies
 from K single-configuration calls measure what batching saves.
 :func:`energy_from_inertia` is an independent oracle from ``get_bodies``
 alone: E = 1/2 omega^T (R I_b R^T) omega + 1/2 m |tdot|^2 with the world
-angular velocity omega = T(r) rdot (see math.md).
+angular velocity omega = T(r) rdot (see docs/derivation.md, "Angular velocity").
 """
 import time
 

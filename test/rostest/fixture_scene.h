@@ -1,7 +1,8 @@
 // The rostest fixture scene (test/urdf/fixture_scene.urdf) worked out in the
-// test, independently of the library, and the math.md oracles evaluated on it.
+// test, independently of the library, and the oracles of docs/derivation.md
+// evaluated on it.
 //
-// Everything here is written from the URDF numbers and from math.md:
+// Everything here is written from the URDF numbers and from docs/derivation.md:
 //   - rotations are products of Eigen::AngleAxisd (R = Rz(psi) Ry(theta) Rx(phi));
 //   - T(r) is assembled column by column from the rotation axes
 //     (omega = psidot e_z + thetadot Rz e_y + phidot Rz Ry e_x);
@@ -31,7 +32,7 @@ using Matrix36d = Eigen::Matrix<double, 3, 6>;
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 
 // ---------------------------------------------------------------------------
-// math.md, written out.
+// docs/derivation.md, written out.
 
 /// R = Rz(psi) Ry(theta) Rx(phi), the URDF rpy and tf2 setRPY convention.
 inline Eigen::Matrix3d rpyRotation(double phi, double theta, double psi)

@@ -3,7 +3,7 @@
 //   (a) central finite differences of the positions and mass matrices the
 //       service itself returns at perturbed q (independent of its Jacobian
 //       and derivative code);
-//   (b) math.md evaluated in the test (fixture_scene.h: AngleAxisd products,
+//   (b) docs/derivation.md evaluated in the test (fixture_scene.h: AngleAxisd products,
 //       M = blockdiag(T^T R I_b R^T T, m I3), J = [-[R p0]_x T, I3],
 //       composite inertia by the parallel-axis theorem);
 //   (c) the core library loading the same URDF in this process.
@@ -278,7 +278,7 @@ TEST(Services, MassMatricesAgainstOracleAndFiniteDifferences)
         const Matrix6d fd = (plus - minus) / (2 * kFiniteDifferenceStep);
         EXPECT_LE(dm_error(maxAbs(dM - fd) / scale), kFiniteDifferenceTolerance)
             << body.name << " dM/dq_" << j << " at q = " << qi.transpose() << "\n" << dM << "\nfd\n" << fd;
-        if (j >= 2)  // yaw symmetry and translation invariance (math.md): exactly zero
+        if (j >= 2)  // yaw symmetry and translation invariance (docs/derivation.md, "Mass matrix"): exactly zero
         {
           EXPECT_EQ(maxAbs(dM), 0.0) << body.name << " dM/dq_" << j;
         }

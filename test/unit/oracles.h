@@ -1,14 +1,15 @@
 // Shared test oracles for the kinematics kernels (rpy.h, mass_matrix.h,
 // vertex_jacobian.h).
 //
-// Everything here is written from /work/shared/design/math.md, NOT from the
+// Everything here is written from docs/derivation.md, NOT from the
 // headers under test: rotations are products of elementary rotations, dR is
 // the long form (Rz Ry Rx' etc.), T is assembled from the definition of the
 // rotation axes, M is T^T R I_b R^T T. The kernels use the closed-form entries,
 // cross products, A = R^T T and A^T I_b A instead, so an agreement between the
 // two is evidence, not a tautology.
 //
-// Also here: fixed-seed random states, the hard-case list of math.md, a
+// Also here: fixed-seed random states, the hard-case list of
+// docs/derivation.md ("Hard cases"), a
 // complex-step helper and error metrics (max-abs, ulp).
 #pragma once
 
@@ -123,7 +124,8 @@ Matrix3<S> rotZPrime(const S& a)
 }
 
 // ---------------------------------------------------------------------------
-// Reference kinematics (math.md), q = (phi, theta, psi, tx, ty, tz).
+// Reference kinematics (docs/derivation.md, "Coordinates and frames",
+// "Angular velocity"), q = (phi, theta, psi, tx, ty, tz).
 
 /// R = Rz(psi) Ry(theta) Rx(phi), as a product of elementary rotations.
 template <typename S>
@@ -192,8 +194,8 @@ Vector3<S> refPosition(const Vector6<S>& q, const Vector3<S>& p0)
   return refRotation(q[0], q[1], q[2]) * p0 + q.template tail<3>();
 }
 
-/// M = blockdiag(T^T I' T, m I3), I' = R I_b R^T: the world-frame form of
-/// the seed's eq. (21) with the corrected (m I3) lower block.
+/// M = blockdiag(T^T I' T, m I3), I' = R I_b R^T: the world-frame form
+/// (docs/derivation.md, "Mass matrix"; the seed's eq. (22) prints I3 for m I3).
 template <typename S>
 Matrix6<S> refMassMatrix(const Vector6<S>& q, const S& mass, const Matrix3<S>& inertia_body)
 {
@@ -207,7 +209,7 @@ Matrix6<S> refMassMatrix(const Vector6<S>& q, const S& mass, const Matrix3<S>& i
   return M;
 }
 
-/// Inertia about the origin of point masses, seed eq. (17):
+/// Inertia about the origin of point masses (docs/derivation.md, "Inertia", particles):
 /// I = sum m_i (p_i^T p_i I3 - p_i p_i^T).
 template <typename S>
 Matrix3<S> particleInertia(const std::vector<Vector3<S>>& points, const std::vector<S>& masses)
@@ -326,7 +328,7 @@ private:
 };
 
 // ---------------------------------------------------------------------------
-// Hard cases (math.md, "Hard cases").
+// Hard cases (docs/derivation.md, "Hard cases").
 
 /// Gimbal lock: theta = +-pi/2 (the doubles nearest) and +-pi/2 +- 10^-k,
 /// k = 1..16. For k >= 16 the offset is below half an ulp of pi/2 and the sum

@@ -1,4 +1,5 @@
-// Gimbal lock: theta = +-pi/2 and +-pi/2 +- 10^-k, k = 1..16 (math.md).
+// Gimbal lock: theta = +-pi/2 and +-pi/2 +- 10^-k, k = 1..16 (docs/derivation.md,
+// "Mass matrix" and "Hard cases").
 //
 // At the lock the X'' axis (T's first column, (cos th cos psi, cos th sin psi,
 // -sin th)) lines up with Z (its third), so:

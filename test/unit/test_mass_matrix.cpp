@@ -2,7 +2,8 @@
 //
 // Oracles:
 //   - the particle identity M = sum_i m_i J_i^T J_i for point masses with
-//     sum m_i p0_i = 0, m = sum m_i and I_b from eq. (17) evaluated here, with
+//     sum m_i p0_i = 0, m = sum m_i and I_b from the particle sum (seed eq. 17)
+//     evaluated here (docs/derivation.md, "Identities used as test oracles"), with
 //     the long-form J of oracles.h (and, to tie the kernels together, the
 //     kernel's vertexJacobian);
 //   - 256-bit MPFR: the same templated kernel run in mpfr::mpreal AND an
@@ -499,8 +500,9 @@ TEST(MassMatrixDerivatives, MatchCentralDifferences)
 }
 
 // ---------------------------------------------------------------------------
-// Seed typo regressions: eq. (22) prints I3 for m I3, eq. (19) prints the e_Y
-// row as cos th cos psi phidot + cos psi thetadot (should be cos th sin psi).
+// Seed typo regressions (docs/derivation.md, "The seed's typos"): eq. (22)
+// prints I3 for m I3, eq. (19) prints the e_Y row as
+// cos th cos psi phidot + cos psi thetadot (should be cos th sin psi).
 
 namespace
 {

@@ -116,7 +116,8 @@ TEST(Rpy, MatchesEigenAngleAxisComposition)
   std::printf("[measured] max |R - AngleAxis(z) AngleAxis(y) AngleAxis(x)| = %.3g eps\n", err.value / kEps);
 }
 
-// math.md: the convention is tf2::Matrix3x3::setRPY(phi, theta, psi) (URDF rpy).
+// docs/derivation.md, "Coordinates and frames": the convention is
+// tf2::Matrix3x3::setRPY(phi, theta, psi) (URDF rpy).
 TEST(Rpy, MatchesTf2SetRPY)
 {
   MaxTracker err;

@@ -696,7 +696,8 @@ TEST(Backprop, ThreadsMatchLongDoubleSum)
 }
 
 // ---------------------------------------------------------------------------
-// Seed typo regression: the seed prints dx/dphi without its parentheses,
+// Seed typo regression (docs/derivation.md, "The seed's typos"): the seed
+// prints dx/dphi without its parentheses,
 //   p_y sin phi sin psi + cos phi sin th cos psi + p_z (...)
 // (and the paper's published code has the same error). The formula as printed
 // differs from the truth by (1 - p_y) cos phi sin th cos psi, so it must be
