@@ -10,6 +10,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -29,13 +30,21 @@ struct MassProperties
 /// |I - I^T| <= kInertiaSymmetryTolerance * max(1, max|I_ij|).
 constexpr double kInertiaSymmetryTolerance = 1e-9;
 
-/// Throws InvalidInertiaError unless
-///   - mass is finite and > 0 [kg], and not subnormal (>= DBL_MIN);
-///   - the tensor is finite and symmetric;
-///   - its eigenvalues (principal moments) are > 0, and not subnormal;
-///   - they satisfy the triangle inequality I1 + I2 >= I3 - eps with
-///     eps = 16 DBL_EPSILON max(1, trace/2) (Drake's tolerance).
-/// `where` names the link or body, and appears in every message.
+/// Checks mass properties read from a description and sorts what is wrong
+/// into two kinds (interface.md, "Inertia from real URDFs"):
+///   - undefined, thrown as InvalidInertiaError: a non-finite or negative mass,
+///     a subnormal mass (m x would round away), a non-finite or asymmetric
+///     tensor, a negative or subnormal principal moment;
+///   - implausible, returned (one message each, naming `where`): mass 0 (a
+///     massless frame; its tensor is then not examined), a zero principal
+///     moment (|I_min| <= eps), principal moments that break the triangle
+///     inequality I1 + I2 >= I3 - eps.
+/// eps = 16 DBL_EPSILON max(1, trace/2) (Drake's tolerance).
+std::vector<std::string> checkMassProperties(const std::string& where, double mass, const Eigen::Matrix3d& inertia);
+
+/// Strict form of checkMassProperties: also throws InvalidInertiaError for
+/// the first implausible finding. Accepts only mass > 0 with a finite,
+/// symmetric, positive-definite tensor that satisfies the triangle inequality.
 void validateMassProperties(const std::string& where, double mass, const Eigen::Matrix3d& inertia);
 
 /// One free rigid body of the scene.

@@ -37,9 +37,15 @@ struct SceneOptions
 {
   GeometrySource geometry = GeometrySource::Collision;
   /// [kg/m^3] When set, a link without <inertial> gets its mass properties
-  /// from its closed geometry. When unset, such a link contributes no mass,
-  /// and a body left with no mass at all is a load error.
+  /// from its closed geometry. When unset, such a link is merged as massless
+  /// (with a warning).
   std::optional<double> density;
+  /// When false (default), implausible inertia loads with a warning naming the
+  /// link (zero mass, no <inertial>, a zero principal moment, the triangle
+  /// inequality broken, a body whose coordinates move no mass); when true,
+  /// each of these is refused with InvalidInertiaError. Undefined inertia
+  /// (negative or non-finite mass or principal moment) is always refused.
+  bool strict_inertia = false;
   /// Names of the bodies to model; empty means all. Meshes of other bodies
   /// are never read. An unknown name is a load error.
   std::vector<std::string> bodies;
@@ -61,6 +67,12 @@ struct LinkInBody
   /// Indices (into RigidBody::vertices) of this link's own geometry vertices,
   /// in the link's geometry order.
   std::vector<std::uint32_t> vertex_indices;
+  /// How many of the body's vertices start at this link: the links' new
+  /// vertices are contiguous, in link order.
+  std::uint32_t new_vertex_count = 0;
+  /// The link's own mass properties, in its link frame: mass [kg], COM [m],
+  /// inertia about the COM in link axes [kg m^2]. Zero for a massless link.
+  MassProperties mass_properties;
 };
 
 struct SceneBody
@@ -90,6 +102,9 @@ struct Scene
   /// One line per joint whose constraint is not modelled, e.g.
   /// "joint 'hinge' (revolute): child 'arm' is modelled as a free body".
   std::vector<std::string> unmodelled_joints;
+  /// Implausible but loadable findings, each naming the link, joint or body:
+  /// massless links, implausible inertia, a body that starts at gimbal lock.
+  std::vector<std::string> warnings;
 
   /// Index of the body called `name`, or -1.
   int findBody(const std::string& name) const;

@@ -6,6 +6,7 @@
 #include <unordered_map>
 
 #include <assimp/Importer.hpp>
+#include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
@@ -106,6 +107,9 @@ TriangleMesh loadMeshFile(const std::string& path, const Eigen::Vector3d& scale)
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
                                                           aiComponent_COLORS | aiComponent_TEXCOORDS |
                                                           aiComponent_BONEWEIGHTS | aiComponent_MATERIALS);
+  // Collada: place the mesh as rviz and MoveIt do, in the file's own axes
+  // with its <unit> applied; assimp would otherwise rotate Z-up files into Y-up.
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
   const aiScene* scene =
       importer.ReadFile(path, aiProcess_RemoveComponent | aiProcess_Triangulate | aiProcess_SortByPType);
   if (!scene || !scene->mRootNode)

@@ -23,7 +23,7 @@ std::string formatMatrix(const Eigen::Matrix3d& m)
 }
 }  // namespace
 
-void validateMassProperties(const std::string& where, double mass, const Eigen::Matrix3d& inertia)
+std::vector<std::string> checkMassProperties(const std::string& where, double mass, const Eigen::Matrix3d& inertia)
 {
   std::ostringstream why;
   why.precision(17);
@@ -32,10 +32,15 @@ void validateMassProperties(const std::string& where, double mass, const Eigen::
     why << where << ": mass must be finite, got " << mass;
     throw InvalidInertiaError(why.str());
   }
-  if (!(mass > 0.0))
+  if (mass < 0.0)
   {
     why << where << ": mass must be > 0 kg, got " << mass;
     throw InvalidInertiaError(why.str());
+  }
+  if (mass == 0.0)  // +0 or -0: a massless frame (tool frames, flanges)
+  {
+    why << where << ": mass must be > 0 kg, got " << mass;
+    return { why.str() };
   }
   if (mass < DBL_MIN)  // subnormal: m x rounds away, so the COM and inertia would be silently wrong
   {
@@ -57,11 +62,14 @@ void validateMassProperties(const std::string& where, double mass, const Eigen::
   const Eigen::Matrix3d symmetric = 0.5 * (inertia + inertia.transpose());
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(symmetric, Eigen::EigenvaluesOnly);
   const Eigen::Vector3d moments = solver.eigenvalues();  // ascending
+  const double eps = 16.0 * DBL_EPSILON * std::max(1.0, moments.cwiseAbs().sum() / 2.0);
   if (!(moments[0] > 0.0))
   {
     why << where << ": inertia must be positive-definite, but its smallest principal moment is " << moments[0]
         << " kg m^2 in " << formatMatrix(inertia);
-    throw InvalidInertiaError(why.str());
+    if (moments[0] < -eps)  // a negative moment: no mass distribution has it
+      throw InvalidInertiaError(why.str());
+    return { why.str() };  // a zero moment: a point mass or a thin rod, M singular in rotation
   }
   if (moments[0] < DBL_MIN)
   {
@@ -69,13 +77,20 @@ void validateMassProperties(const std::string& where, double mass, const Eigen::
         << " kg m^2), but the smallest is " << moments[0] << " kg m^2 in " << formatMatrix(inertia);
     throw InvalidInertiaError(why.str());
   }
-  const double eps = 16.0 * DBL_EPSILON * std::max(1.0, moments.sum() / 2.0);
   if (moments[0] + moments[1] < moments[2] - eps)
   {
     why << where << ": principal moments break the triangle inequality I1 + I2 >= I3: " << moments[0] << " + "
         << moments[1] << " < " << moments[2] << " kg m^2";
-    throw InvalidInertiaError(why.str());
+    return { why.str() };
   }
+  return {};
+}
+
+void validateMassProperties(const std::string& where, double mass, const Eigen::Matrix3d& inertia)
+{
+  const std::vector<std::string> implausible = checkMassProperties(where, mass, inertia);
+  if (!implausible.empty())
+    throw InvalidInertiaError(implausible.front());
 }
 
 }  // namespace diff_rigid_body

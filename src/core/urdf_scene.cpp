@@ -8,6 +8,7 @@
 #include <sstream>
 #include <unordered_map>
 
+#include <Eigen/Eigenvalues>
 #include <console_bridge/console.h>
 #include <tinyxml2.h>
 #include <urdf_parser/urdf_parser.h>
@@ -20,6 +21,9 @@ namespace diff_rigid_body
 {
 namespace
 {
+/// [rad] A floating body whose initial pitch is this close to +-pi/2 loads with a warning.
+constexpr double kGimbalLockWarningAngle = 1e-6;
+
 // Collects urdfdom's console_bridge errors while it parses, so that they can
 // be quoted in the exception instead of only reaching stderr.
 class CapturedUrdfdomErrors : public console_bridge::OutputHandler
@@ -177,6 +181,7 @@ public:
                                           "): its constraint is not modelled; child '" + name +
                                           "' is a free body posed at joint value 0");
     }
+    scene.warnings = std::move(warnings_);
     return scene;
   }
 
@@ -353,78 +358,21 @@ private:
 
     for (const std::string& name : members)
     {
-      const urdf::LinkConstSharedPtr link = model_->getLink(name);
       LinkInBody slot;
       slot.name = name;
       slot.pose_in_body_link = body_in_root.inverse() * pose_in_root_.at(name);
-
-      std::vector<std::pair<Eigen::Isometry3d, const urdf::Geometry*>> geometries = linkGeometries(*link);
-      std::vector<std::pair<Eigen::Isometry3d, MassProperties>> geometry_masses;
-      for (const auto& [origin, geometry] : geometries)
-      {
-        if (!origin.matrix().allFinite())
-          throw SceneDescriptionError("link '" + name + "': geometry <origin> is not finite");
-        const TriangleMesh mesh = geometryMesh(*geometry, name);
-        const Eigen::Isometry3d in_body_link = slot.pose_in_body_link * origin;
-        for (Eigen::Index v = 0; v < mesh.vertices.cols(); ++v)
-          link_vertices.emplace_back(scene_body.links.size(), in_body_link * mesh.vertices.col(v));
-        if (!link->inertial && options_.density)
-          geometry_masses.emplace_back(origin, geometryMassProperties(*geometry, mesh, *options_.density, name));
-      }
-
-      if (link->inertial)
-      {
-        const urdf::Inertial& inertial = *link->inertial;
-        const Eigen::Isometry3d frame = toIsometry(inertial.origin);
-        if (!frame.matrix().allFinite())
-          throw InvalidInertiaError("link '" + name + "' <inertial>: <origin> is not finite");
-        Eigen::Matrix3d inertia;
-        inertia << inertial.ixx, inertial.ixy, inertial.ixz,  //
-            inertial.ixy, inertial.iyy, inertial.iyz,         //
-            inertial.ixz, inertial.iyz, inertial.izz;
-        validateMassProperties("link '" + name + "' <inertial>", inertial.mass, inertia);
-        MassProperties properties;
-        properties.mass = inertial.mass;
-        properties.com = frame.translation();
-        properties.inertia = frame.linear() * inertia * frame.linear().transpose();  // I_link = R_o I R_o^T
-        link_masses.emplace_back(slot.pose_in_body_link, properties);
-      }
-      else if (!geometry_masses.empty())
-      {
-        link_masses.emplace_back(slot.pose_in_body_link,
-                                 combineMassProperties(geometry_masses, "link '" + name + "' geometry"));
-      }
+      slot.mass_properties = addLinkGeometry(*model_->getLink(name), slot.pose_in_body_link, scene_body.links.size(),
+                                             link_vertices);
+      if (slot.mass_properties.mass > 0.0)
+        link_masses.emplace_back(slot.pose_in_body_link, slot.mass_properties);
       scene_body.links.push_back(std::move(slot));
     }
 
-    if (link_masses.empty())
-      throw InvalidInertiaError("body '" + body_name + "': no <inertial> in its link or merged links" +
-                                (options_.density ? std::string(" and no geometry to compute one from") :
-                                                    std::string(", and parameter density is not set")));
-    const MassProperties composite = combineMassProperties(link_masses, "body '" + body_name + "'");
-    validateMassProperties("body '" + body_name + "'", composite.mass, composite.inertia);
+    const MassProperties composite = bodyMassProperties(body_name, link_masses);
     scene_body.body.mass = composite.mass;
     scene_body.body.com_offset = composite.com;
     scene_body.body.inertia_body = composite.inertia;
-
-    // Unique positions in the body frame (origin at the COM), first occurrence order.
-    std::map<std::array<double, 3>, std::uint32_t> index_of;
-    std::vector<Eigen::Vector3d> unique;
-    for (const auto& [slot, position] : link_vertices)
-    {
-      const Eigen::Vector3d p = position - composite.com;
-      const std::array<double, 3> key{ p.x() + 0.0, p.y() + 0.0, p.z() + 0.0 };  // + 0.0 folds -0 into +0
-      const auto inserted = index_of.emplace(key, static_cast<std::uint32_t>(unique.size()));
-      if (inserted.second)
-        unique.push_back(p);
-      scene_body.links[slot].vertex_indices.push_back(inserted.first->second);
-    }
-    scene_body.body.vertices.resize(3, static_cast<Eigen::Index>(unique.size()));
-    for (std::size_t i = 0; i < unique.size(); ++i)
-      scene_body.body.vertices.col(static_cast<Eigen::Index>(i)) = unique[i];
-
-    if (!scene_body.body.vertices.allFinite())
-      throw SceneDescriptionError("body '" + body_name + "': vertex coordinates overflow (check mesh scales)");
+    joinBodyVertices(link_vertices, composite.com, scene_body);
 
     // Initial state: link axes' RPY and COM position, in the fixed frame.
     const Eigen::Isometry3d body_in_fixed = fixed_from_root * body_in_root;
@@ -434,7 +382,134 @@ private:
       throw SceneDescriptionError("body '" + body_name +
                                   "': initial state is not finite (its joint origins and COM offset add up "
                                   "beyond the range of double)");
+    warnIfGimbalLocked(scene_body);
     return scene_body;
+  }
+
+  // Appends the vertices of one member link's geometry (in the body link
+  // frame) to `link_vertices`, and returns the link's mass properties in its
+  // own frame: from <inertial>, else from its geometry and ~density, else
+  // massless. Implausible inertia is reported (or refused when strict).
+  MassProperties addLinkGeometry(const urdf::Link& link, const Eigen::Isometry3d& pose_in_body_link, std::size_t slot,
+                                 std::vector<std::pair<std::size_t, Eigen::Vector3d>>& link_vertices)
+  {
+    std::vector<std::pair<Eigen::Isometry3d, MassProperties>> geometry_masses;
+    for (const auto& [origin, geometry] : linkGeometries(link))
+    {
+      if (!origin.matrix().allFinite())
+        throw SceneDescriptionError("link '" + link.name + "': geometry <origin> is not finite");
+      const TriangleMesh mesh = geometryMesh(*geometry, link.name);
+      const Eigen::Isometry3d in_body_link = pose_in_body_link * origin;
+      for (Eigen::Index v = 0; v < mesh.vertices.cols(); ++v)
+        link_vertices.emplace_back(slot, in_body_link * mesh.vertices.col(v));
+      if (!link.inertial && options_.density)
+        geometry_masses.emplace_back(origin, geometryMassProperties(*geometry, mesh, *options_.density, link.name));
+    }
+    if (link.inertial)
+      return inertialMassProperties(link.name, *link.inertial);
+    if (!geometry_masses.empty())
+      return combineMassProperties(geometry_masses, "link '" + link.name + "' geometry");
+    reportImplausible("link '" + link.name + "': no <inertial>" +
+                          (options_.density ? std::string(" and no geometry to compute one from") :
+                                              std::string(" (set ~density to compute one from its geometry)")),
+                      "merged as massless");
+    return MassProperties();
+  }
+
+  // <inertial> in the link frame: I_link = R_o I R_o^T about the COM.
+  MassProperties inertialMassProperties(const std::string& link_name, const urdf::Inertial& inertial)
+  {
+    const Eigen::Isometry3d frame = toIsometry(inertial.origin);
+    if (!frame.matrix().allFinite())
+      throw InvalidInertiaError("link '" + link_name + "' <inertial>: <origin> is not finite");
+    Eigen::Matrix3d inertia;
+    inertia << inertial.ixx, inertial.ixy, inertial.ixz,  //
+        inertial.ixy, inertial.iyy, inertial.iyz,         //
+        inertial.ixz, inertial.iyz, inertial.izz;
+    const std::string where = "link '" + link_name + "' <inertial>";
+    for (const std::string& finding : checkMassProperties(where, inertial.mass, inertia))
+      reportImplausible(finding, inertial.mass == 0.0 ? "merged as massless" : "loaded as given");
+    if (inertial.mass == 0.0)
+      return MassProperties();
+    MassProperties properties;
+    properties.mass = inertial.mass;
+    properties.com = frame.translation();
+    properties.inertia = frame.linear() * inertia * frame.linear().transpose();
+    return properties;
+  }
+
+  // Composite of the body's massive links in the body link frame. A body
+  // without mass has its COM at the link origin and M = 0 (reported).
+  MassProperties bodyMassProperties(const std::string& body_name,
+                                    const std::vector<std::pair<Eigen::Isometry3d, MassProperties>>& link_masses)
+  {
+    if (link_masses.empty())
+    {
+      reportImplausible("body '" + body_name +
+                            "': no mass in its link or merged links, so M(q) = 0 and no coordinate moves mass "
+                            "(set ~density to give links without <inertial> a mass from their geometry)",
+                        "loaded with M(q) = 0");
+      return MassProperties();
+    }
+    const MassProperties composite = combineMassProperties(link_masses, "body '" + body_name + "'");
+    checkMassProperties("body '" + body_name + "'", composite.mass, composite.inertia);  // undefined: throws
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(composite.inertia, Eigen::EigenvaluesOnly);
+    if (!(solver.eigenvalues()[0] > 0.0))
+      reportImplausible("body '" + body_name + "': a principal moment of its inertia is 0, so M(q) is singular in " +
+                            "its rotation coordinates (phi, theta, psi)",
+                        "loaded as given");
+    return composite;
+  }
+
+  // Unique positions in the body frame (origin at the COM), in first
+  // occurrence order; each link's new vertices are contiguous.
+  void joinBodyVertices(const std::vector<std::pair<std::size_t, Eigen::Vector3d>>& link_vertices,
+                        const Eigen::Vector3d& com, SceneBody& scene_body) const
+  {
+    std::map<std::array<double, 3>, std::uint32_t> index_of;
+    std::vector<Eigen::Vector3d> unique;
+    for (const auto& [slot, position] : link_vertices)
+    {
+      const Eigen::Vector3d p = position - com;
+      const std::array<double, 3> key{ p.x() + 0.0, p.y() + 0.0, p.z() + 0.0 };  // + 0.0 folds -0 into +0
+      const auto inserted = index_of.emplace(key, static_cast<std::uint32_t>(unique.size()));
+      if (inserted.second)
+      {
+        unique.push_back(p);
+        ++scene_body.links[slot].new_vertex_count;
+      }
+      scene_body.links[slot].vertex_indices.push_back(inserted.first->second);
+    }
+    scene_body.body.vertices.resize(3, static_cast<Eigen::Index>(unique.size()));
+    for (std::size_t i = 0; i < unique.size(); ++i)
+      scene_body.body.vertices.col(static_cast<Eigen::Index>(i)) = unique[i];
+    if (!scene_body.body.vertices.allFinite())
+      throw SceneDescriptionError("body '" + scene_body.body.name +
+                                  "': vertex coordinates overflow (check mesh scales)");
+  }
+
+  // A body whose initial pitch is within kGimbalLockWarningAngle of +-pi/2
+  // starts where M(q) is singular: cos(theta) <= sin(1e-6).
+  void warnIfGimbalLocked(const SceneBody& scene_body)
+  {
+    const double theta = scene_body.initial_state[1];
+    if (std::abs(std::cos(theta)) > std::sin(kGimbalLockWarningAngle))
+      return;
+    std::ostringstream why;
+    why.precision(17);
+    why << "body '" << scene_body.body.name << "' (joint '" << scene_body.joint_name << "', "
+        << scene_body.joint_type << ") starts at gimbal lock: pitch theta = " << theta << " rad, cos(theta) = "
+        << std::cos(theta) << "; M(q) is singular there (rank 5)";
+    warnings_.push_back(why.str());
+  }
+
+  // An implausible finding: a warning saying what was done about it
+  // (`consequence`), or a refusal with ~strict_inertia.
+  void reportImplausible(const std::string& finding, const std::string& consequence)
+  {
+    if (options_.strict_inertia)
+      throw InvalidInertiaError(finding + " (refused: ~strict_inertia is true)");
+    warnings_.push_back(finding + "; " + consequence + " (~strict_inertia: true refuses it)");
   }
 
   // The link's chosen geometry elements (collision or visual, falling back to
@@ -460,6 +535,7 @@ private:
   std::unordered_map<std::string, std::string> owner_;
   std::unordered_map<std::string, std::vector<std::string>> merged_links_;  ///< body -> merged links, document order
   std::map<std::pair<std::string, std::array<double, 3>>, TriangleMesh> mesh_cache_;
+  std::vector<std::string> warnings_;
 };
 
 }  // namespace

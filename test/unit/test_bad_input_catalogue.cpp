@@ -158,6 +158,24 @@ std::function<std::string()> load(const std::string& xml, drb::SceneOptions opti
   };
 }
 
+drb::SceneOptions strict()
+{
+  drb::SceneOptions options = withPackages();
+  options.strict_inertia = true;
+  return options;
+}
+
+/// Loads a description that must load with at least one warning; the outcome
+/// quotes the first.
+std::function<std::string()> loadWithWarning(const std::string& xml)
+{
+  return [xml] {
+    const drb::Scene scene = drb::loadSceneFromUrdf(xml, withPackages());
+    EXPECT_FALSE(scene.warnings.empty()) << "loaded without a warning";
+    return "loaded with a warning: " + (scene.warnings.empty() ? std::string("(none)") : scene.warnings.front());
+  };
+}
+
 drb::SceneOptions density(double value)
 {
   drb::SceneOptions options = withPackages();
@@ -232,8 +250,10 @@ std::vector<Row> urdfRows()
       load(oneBody(inertial("inf"))) },
     { "U24", "mass -Inf", Expect::Refused, "SceneDescriptionError", "mass [-inf] is not a float",
       load(oneBody(inertial("-inf"))) },
-    { "U25", "mass 0", Expect::Refused, "InvalidInertiaError", "mass must be > 0", load(oneBody(inertial("0"))) },
-    { "U26", "mass -0", Expect::Refused, "InvalidInertiaError", "mass must be > 0", load(oneBody(inertial("-0"))) },
+    { "U25", "mass 0, with ~strict_inertia", Expect::Refused, "InvalidInertiaError", "mass must be > 0",
+      load(oneBody(inertial("0")), strict()) },
+    { "U26", "mass -0, with ~strict_inertia", Expect::Refused, "InvalidInertiaError", "mass must be > 0",
+      load(oneBody(inertial("-0")), strict()) },
     { "U27", "mass negative", Expect::Refused, "InvalidInertiaError", "mass must be > 0",
       load(oneBody(inertial("-1"))) },
     { "U28", "mass subnormal (4.9e-324)", Expect::Refused, "InvalidInertiaError", "mass must be a normal number",
@@ -261,14 +281,15 @@ std::vector<Row> urdfRows()
       load(inertiaWith(0, "inf")) },
     { "U39", "inertia iyz -Inf", Expect::Refused, "SceneDescriptionError", "inertia element iyz is not a valid double",
       load(inertiaWith(4, "-inf")) },
-    { "U40", "inertia all zero", Expect::Refused, "InvalidInertiaError", "must be positive-definite",
-      load(oneBody(inertial("1", { "0", "0", "0", "0", "0", "0" }))) },
+    { "U40", "inertia all zero, with ~strict_inertia", Expect::Refused, "InvalidInertiaError",
+      "must be positive-definite", load(oneBody(inertial("1", { "0", "0", "0", "0", "0", "0" })), strict()) },
     { "U41", "inertia with a negative diagonal entry", Expect::Refused, "InvalidInertiaError",
       "must be positive-definite", load(inertiaWith(3, "-0.1")) },
     { "U42", "inertia indefinite (large off-diagonal)", Expect::Refused, "InvalidInertiaError",
       "must be positive-definite", load(inertiaWith(1, "0.5")) },
-    { "U43", "principal moments break the triangle inequality (1, 1, 3)", Expect::Refused, "InvalidInertiaError",
-      "triangle inequality", load(oneBody(inertial("1", { "1", "0", "0", "1", "0", "3" }))) },
+    { "U43", "principal moments break the triangle inequality (1, 1, 3), with ~strict_inertia", Expect::Refused,
+      "InvalidInertiaError", "triangle inequality",
+      load(oneBody(inertial("1", { "1", "0", "0", "1", "0", "3" })), strict()) },
     { "U44", "inertia subnormal (1e-320 on the diagonal)", Expect::Refused, "InvalidInertiaError",
       "principal moments must be normal numbers",
       load(oneBody(inertial("1", { "1e-320", "0", "0", "1e-320", "0", "1e-320" }))) },
@@ -280,8 +301,8 @@ std::vector<Row> urdfRows()
         drb::validateMassProperties("link 'b' <inertial>", 1.0, inertia);
         return std::string("accepted");
       } },
-    { "U46", "no <inertial> and no ~density", Expect::Refused, "InvalidInertiaError", "no <inertial>",
-      load(oneBody(box)) },
+    { "U46", "no <inertial> and no ~density, with ~strict_inertia", Expect::Refused, "InvalidInertiaError",
+      "no <inertial>", load(oneBody(box), strict()) },
     { "U47", "~density NaN", Expect::Refused, "SceneDescriptionError", "parameter density",
       load(oneBody(box), density(kNaN)) },
     { "U48", "~density 0", Expect::Refused, "SceneDescriptionError", "parameter density",
@@ -404,6 +425,14 @@ std::vector<Row> urdfRows()
         EXPECT_LT(seconds, 60.0) << "loading is not linear in the bodies any more";
         return std::string("accepted: linear time");
       } },
+    { "U81", "mass 0 (a massless frame)", Expect::Accepted, "", "", loadWithWarning(oneBody(inertial("0"))) },
+    { "U82", "inertia all zero", Expect::Accepted, "", "",
+      loadWithWarning(oneBody(inertial("1", { "0", "0", "0", "0", "0", "0" }))) },
+    { "U83", "principal moments break the triangle inequality (1, 1, 3)", Expect::Accepted, "", "",
+      loadWithWarning(oneBody(inertial("1", { "1", "0", "0", "1", "0", "3" }))) },
+    { "U84", "no <inertial> and no ~density", Expect::Accepted, "", "", loadWithWarning(oneBody(box)) },
+    { "U85", "a floating body that starts at pitch pi/2 (gimbal lock)", Expect::Accepted, "", "",
+      loadWithWarning(oneBody(I, "<origin rpy=\"0 1.5707963267948966 0\"/>")) },
   };
   rows.insert(rows.end(), more.begin(), more.end());
   return rows;
