@@ -87,6 +87,15 @@ SceneState initialState(const SceneQueries& queries, const std::string& state_fi
   return state;
 }
 
+// Appends `matrix` row-major to `out`.
+template <typename Matrix>
+void appendMatrix(const Matrix& matrix, std::vector<double>& out)
+{
+  for (Eigen::Index r = 0; r < matrix.rows(); ++r)
+    for (Eigen::Index c = 0; c < matrix.cols(); ++c)
+      out.push_back(matrix(r, c));
+}
+
 std::vector<NamedState> toNamedStates(const std::vector<BodyState>& states)
 {
   std::vector<NamedState> named;
@@ -101,6 +110,7 @@ RigidBodyServer::RigidBodyServer(ros::NodeHandle& nh, ros::NodeHandle& private_n
                                  const ServerSettings& settings)
   : queries_(std::move(scene))
   , state_file_(settings.state_file)
+  , frame_prefix_(settings.frame_prefix)
   , state_(std::make_shared<const SceneState>(initialState(queries_, state_file_)))
 {
   tf_subscriber_counter_ = nh.advertise<tf2_msgs::TFMessage>("/tf", 100);  // as tf2_ros::TransformBroadcaster
@@ -158,7 +168,7 @@ void RigidBodyServer::initOutgoingMessages(const SceneState& state)
   for (const SceneBody& body : scene.bodies)
     first_transform_of_body_.push_back(first_transform_of_body_.back() + body.links.size());
   body_transforms_.resize(first_transform_of_body_.back());
-  states_message_.header.frame_id = scene.fixed_frame;
+  states_message_.header.frame_id = frame_prefix_ + scene.fixed_frame;
   states_message_.states.resize(scene.bodies.size());
   for (std::size_t i = 0; i < scene.bodies.size(); ++i)
   {
@@ -166,8 +176,8 @@ void RigidBodyServer::initOutgoingMessages(const SceneState& state)
     for (std::size_t l = 0; l < body.links.size(); ++l)
     {
       geometry_msgs::TransformStamped& transform = body_transforms_[first_transform_of_body_[i] + l];
-      transform.header.frame_id = scene.fixed_frame;
-      transform.child_frame_id = body.links[l].name;
+      transform.header.frame_id = frame_prefix_ + scene.fixed_frame;
+      transform.child_frame_id = frame_prefix_ + body.links[l].name;
     }
     states_message_.states[i].name = body.body.name;
     writeBodyToOutgoingMessages(i, state[i]);
@@ -220,8 +230,8 @@ void RigidBodyServer::publishStaticLinks()
   for (std::size_t i = 0; i < scene.static_links.size(); ++i)
   {
     transforms[i].header.stamp = stamp;
-    transforms[i].header.frame_id = scene.fixed_frame;
-    transforms[i].child_frame_id = scene.static_links[i].name;
+    transforms[i].header.frame_id = frame_prefix_ + scene.fixed_frame;
+    transforms[i].child_frame_id = frame_prefix_ + scene.static_links[i].name;
     setTransform(scene.static_links[i].pose_in_fixed_frame, transforms[i].transform);
   }
   static_broadcaster_.sendTransform(transforms);
@@ -230,18 +240,26 @@ void RigidBodyServer::publishStaticLinks()
 bool RigidBodyServer::getBodies(GetBodies::Request&, GetBodies::Response& response)
 {
   return serve(response, "get_bodies", [&] {
-    response.fixed_frame = queries_.scene().fixed_frame;
-    for (std::size_t i = 0; i < queries_.bodyCount(); ++i)
+    response.fixed_frame = frame_prefix_ + queries_.scene().fixed_frame;
+    for (const SceneBody& scene_body : queries_.scene().bodies)
     {
-      const RigidBody& body = queries_.body(i);
+      const RigidBody& body = scene_body.body;
       response.names.push_back(body.name);
       response.masses.push_back(body.mass);
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c)
-          response.inertias.push_back(body.inertia_body(r, c));
-      for (int k = 0; k < 3; ++k)
-        response.com_offsets.push_back(body.com_offset[k]);
+      appendMatrix(body.inertia_body, response.inertias);
+      appendMatrix(body.com_offset, response.com_offsets);
       response.vertex_counts.push_back(static_cast<std::uint32_t>(body.vertices.cols()));
+      response.dofs.push_back(6);
+      response.joint_counts.push_back(0);
+      response.link_counts.push_back(static_cast<std::uint32_t>(scene_body.links.size()));
+      for (const LinkInBody& link : scene_body.links)
+      {
+        response.link_names.push_back(link.name);
+        response.link_vertex_counts.push_back(link.new_vertex_count);
+        response.link_masses.push_back(link.mass_properties.mass);
+        appendMatrix(link.mass_properties.inertia, response.link_inertias);
+        appendMatrix(link.mass_properties.com, response.link_com_offsets);
+      }
     }
   });
 }

@@ -56,6 +56,10 @@ struct ServerSettings
   /// ~state_file: "" (off), or a file that every accepted state change is
   /// written to durably before it is acknowledged, and resumed from on start.
   std::string state_file;
+  /// ~frame_prefix: prepended to every frame id the node publishes or
+  /// reports (tf parent and child, /tf_static, ~states, get_bodies), as
+  /// robot_state_publisher's frame_prefix; "" by default.
+  std::string frame_prefix;
 };
 
 class RigidBodyServer
@@ -101,6 +105,7 @@ private:
 
   const SceneQueries queries_;
   const std::string state_file_;       ///< "" when durable state is off
+  const std::string frame_prefix_;     ///< ~frame_prefix
   mutable std::mutex snapshot_mutex_;  ///< guards state_ (the pointer, not the data)
   std::mutex write_mutex_;             ///< serialises state changes and their publication
   StatePtr state_;

@@ -50,6 +50,10 @@ drb::SceneOptions readSceneOptions(const ros::NodeHandle& private_nh)
   else if (private_nh.hasParam("density"))
     throw drb::SceneDescriptionError("parameter ~density: must be a number [kg/m^3]");
   options.bodies = readBodies(private_nh);
+  options.strict_inertia = private_nh.param("strict_inertia", false);
+  const std::string joints = private_nh.param<std::string>("joints", "model");
+  if (joints != "model" && joints != "free")
+    throw drb::SceneDescriptionError("parameter ~joints: must be 'model' or 'free', got '" + joints + "'");
   options.fixed_frame = private_nh.param<std::string>("fixed_frame", "");
   options.find_package = [](const std::string& package) { return ros::package::getPath(package); };
   return options;
@@ -86,6 +90,7 @@ int main(int argc, char** argv)
     ROS_WARN("~publish_rate %g Hz is out of range; using %g Hz", rate, settings.publish_rate);
   const int threads = std::clamp(private_nh.param("threads", 4), 1, 64);
   settings.state_file = private_nh.param<std::string>("state_file", "");
+  settings.frame_prefix = private_nh.param<std::string>("frame_prefix", "");
 
   drb::Scene scene;
   try
@@ -97,8 +102,13 @@ int main(int argc, char** argv)
     ROS_FATAL_STREAM("rigid_body_server: cannot load the scene: " << e.what());
     return 1;
   }
+  if (!scene.unmodelled_joints.empty() && private_nh.param<std::string>("joints", "model") == "model")
+    ROS_WARN("rigid_body_server: ~joints 'model' (articulated bodies) is not implemented yet: the children of "
+             "1-dof joints are free bodies, as with ~joints: free");
   for (const std::string& joint : scene.unmodelled_joints)
     ROS_INFO_STREAM("rigid_body_server: " << joint);
+  for (const std::string& warning : scene.warnings)
+    ROS_WARN_STREAM("rigid_body_server: " << warning);
 
   std::ostringstream summary;
   for (const drb::SceneBody& body : scene.bodies)
