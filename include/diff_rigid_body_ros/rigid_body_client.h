@@ -63,6 +63,17 @@ public:
   using std::runtime_error::runtime_error;
 };
 
+/// One link of a body (get_bodies), in vertex order.
+struct Link
+{
+  std::string name;
+  double mass = 0.0;                                  ///< [kg], 0 for a massless frame
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();  ///< [kg m^2] about its COM, link axes
+  Eigen::Vector3d com_offset = Eigen::Vector3d::Zero();  ///< [m] its COM in its frame
+  std::uint32_t first_vertex = 0;  ///< its vertices: first_vertex .. first_vertex + vertex_count - 1
+  std::uint32_t vertex_count = 0;
+};
+
 /// get_bodies.
 struct Bodies
 {
@@ -72,6 +83,9 @@ struct Bodies
   std::vector<Eigen::Matrix3d> inertias;          ///< [kg m^2] about the COM, body axes
   std::vector<Eigen::Vector3d> com_offsets;       ///< [m] the COM in the link frame
   std::vector<std::uint32_t> vertex_counts;
+  std::vector<std::uint32_t> dofs;                ///< len(x) per body
+  std::vector<std::vector<std::string>> joint_names;  ///< per body, in x order
+  std::vector<std::vector<Link>> links;           ///< per body, in vertex order
 };
 
 /// get_mass_matrix: K configurations of n bodies.
@@ -116,11 +130,39 @@ public:
     out.names = srv.response.names;
     out.masses = srv.response.masses;
     out.vertex_counts = srv.response.vertex_counts;
+    out.dofs = srv.response.dofs;
     for (std::size_t i = 0; i < out.names.size(); ++i)
     {
       out.inertias.push_back(Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(
           srv.response.inertias.data() + 9 * i));
       out.com_offsets.push_back(Eigen::Map<const Eigen::Vector3d>(srv.response.com_offsets.data() + 3 * i));
+    }
+    std::size_t joint = 0;
+    for (std::uint32_t count : srv.response.joint_counts)
+    {
+      out.joint_names.emplace_back(srv.response.joint_names.begin() + joint,
+                                   srv.response.joint_names.begin() + joint + count);
+      joint += count;
+    }
+    std::size_t link = 0;
+    for (std::uint32_t count : srv.response.link_counts)
+    {
+      std::vector<Link> links;
+      std::uint32_t first_vertex = 0;
+      for (std::uint32_t k = 0; k < count; ++k, ++link)
+      {
+        Link l;
+        l.name = srv.response.link_names[link];
+        l.mass = srv.response.link_masses[link];
+        l.inertia = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(
+            srv.response.link_inertias.data() + 9 * link);
+        l.com_offset = Eigen::Map<const Eigen::Vector3d>(srv.response.link_com_offsets.data() + 3 * link);
+        l.first_vertex = first_vertex;
+        l.vertex_count = srv.response.link_vertex_counts[link];
+        first_vertex += l.vertex_count;
+        links.push_back(std::move(l));
+      }
+      out.links.push_back(std::move(links));
     }
     return out;
   }

@@ -52,12 +52,42 @@ class DiffRigidBodyError(RuntimeError):
 
 #: ``get_bodies``: fixed_frame (str), names (list of str), masses (n,) [kg],
 #: inertias (n, 3, 3) [kg m^2] about the COM in body axes, com_offsets (n, 3) [m]
-#: in the link frame, vertex_counts (n,).
-Bodies = collections.namedtuple('Bodies', 'fixed_frame names masses inertias com_offsets vertex_counts')
+#: in the link frame, vertex_counts (n,); dofs (n,), joints (per body: a list of
+#: :data:`Joint`) and links (per body: a list of :data:`Link`, in vertex order).
+Bodies = collections.namedtuple('Bodies', 'fixed_frame names masses inertias com_offsets vertex_counts dofs joints '
+                                          'links')
+
+#: One joint coordinate of a body: name, lower and upper limit [rad or m] (+-inf where none).
+Joint = collections.namedtuple('Joint', 'name lower upper')
+
+#: One link of a body: name, mass [kg] (0 for a massless frame), inertia (3, 3) [kg m^2]
+#: about its COM in link axes, com_offset (3,) [m] in its frame, and its vertices:
+#: the body's vertices first..first+vertex_count-1 (contiguous, in link order).
+Link = collections.namedtuple('Link', 'name mass inertia com_offset first_vertex vertex_count')
 
 #: ``get_mass_matrix``: bodies (list of str), M, dM (None unless derivatives
 #: were asked for) and cos_theta ((n,) or (K, n): the gimbal-lock diagnostic).
 MassMatrices = collections.namedtuple('MassMatrices', 'bodies M dM cos_theta')
+
+
+def _split(counts, items):
+    """``items`` cut into consecutive lists of ``counts[i]`` items."""
+    ends = np.cumsum(np.asarray(counts, dtype=np.int64))
+    return [list(items[end - count:end]) for count, end in zip(counts, ends)]
+
+
+def _links(r):
+    """The links of a get_bodies response, flattened, with their first vertex within their body."""
+    inertias = np.asarray(r.link_inertias).reshape(-1, 3, 3)
+    coms = np.asarray(r.link_com_offsets).reshape(-1, 3)
+    links = []
+    for body_links in _split(r.link_counts, list(range(len(r.link_names)))):
+        first = 0
+        for k in body_links:
+            links.append(Link(r.link_names[k], r.link_masses[k], inertias[k], coms[k], first,
+                              int(r.link_vertex_counts[k])))
+            first += int(r.link_vertex_counts[k])
+    return links
 
 
 def _numpy_service(service_class):
@@ -165,7 +195,10 @@ class RigidBodyClient(object):
         r = self.call('get_bodies')
         n = len(r.names)
         return Bodies(r.fixed_frame, list(r.names), np.asarray(r.masses), np.asarray(r.inertias).reshape(n, 3, 3),
-                      np.asarray(r.com_offsets).reshape(n, 3), np.asarray(r.vertex_counts))
+                      np.asarray(r.com_offsets).reshape(n, 3), np.asarray(r.vertex_counts), np.asarray(r.dofs),
+                      _split(r.joint_counts, [Joint(name, lower, upper) for name, lower, upper in
+                                              zip(r.joint_names, r.joint_lower, r.joint_upper)]),
+                      _split(r.link_counts, _links(r)))
 
     def get_state(self, bodies=None):
         """dict body name -> q (6,), in the node's order (``bodies`` None = all)."""

@@ -37,6 +37,16 @@ TEST(CppClient, BodiesOfTheDefaultScene)
   EXPECT_EQ(bodies.vertex_counts.at(0), 4096u);
   EXPECT_NEAR(bodies.masses.at(0), 0.28125334, 1e-12);
   EXPECT_NEAR(bodies.inertias.at(0)(2, 2), 6.0365524e-04, 1e-12);
+  // Links in vertex order: the rock's own link, then its merged handle (masses from the URDF).
+  ASSERT_EQ(bodies.links.size(), 2u);
+  ASSERT_EQ(bodies.links.at(1).size(), 2u);
+  EXPECT_EQ(bodies.links[1][0].name, "rock");
+  EXPECT_EQ(bodies.links[1][0].mass, 1.39997);
+  EXPECT_EQ(bodies.links[1][1].name, "rock_handle");
+  EXPECT_EQ(bodies.links[1][1].mass, 0.05);
+  EXPECT_EQ(bodies.links[1][1].first_vertex, bodies.links[1][0].vertex_count);
+  EXPECT_EQ(bodies.links[1][0].vertex_count + bodies.links[1][1].vertex_count, bodies.vertex_counts.at(1));
+  EXPECT_EQ(bodies.dofs, (std::vector<std::uint32_t>{ 6, 6 }));
 }
 
 TEST(CppClient, BatchedMassMatricesMatchSingleCallsAndLayout)

@@ -45,6 +45,13 @@ class PythonClient(unittest.TestCase):
         self.assertEqual(bodies.names, ['knot', 'rock'])
         self.assertEqual(bodies.inertias.shape, (2, 3, 3))
         self.assertEqual(bodies.com_offsets.shape, (2, 3))
+        # Links in vertex order: the rock's own link, then its merged handle (masses from the URDF).
+        self.assertEqual([link.name for link in bodies.links[1]], ['rock', 'rock_handle'])
+        self.assertEqual([link.mass for link in bodies.links[1]], [1.39997, 0.05])
+        self.assertEqual(bodies.links[1][1].first_vertex, bodies.links[1][0].vertex_count)
+        self.assertEqual(sum(link.vertex_count for link in bodies.links[1]), bodies.vertex_counts[1])
+        self.assertEqual(list(bodies.dofs), [6, 6])
+        self.assertEqual(bodies.joints, [[], []])
         states = c.get_state()
         self.assertEqual(list(states), ['knot', 'rock'])
         self.assertEqual(states['knot'].shape, (6,))
