@@ -2,6 +2,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <array>
 #include <map>
 #include <string>
 
@@ -152,4 +153,53 @@ TEST(PrimitiveMesh, DocumentedResolutionClosedAndOutward)
   EXPECT_TRUE(isClosedAndOriented(cylinder));
   // Inscribed 32-gon prism: (n/2) r^2 sin(2 pi / n) * length.
   EXPECT_NEAR(signedVolume(cylinder), 16.0 * 0.25 * std::sin(2.0 * pi / 32.0) * 2.0, kLengthTolerance);
+}
+
+// assimp stores positions as float32 (ai_real), so a text file's decimal
+// coordinates are rounded once: |p_loaded - p_file| <= 2^-24 |p_file| per
+// coordinate for correctly rounded parsing, 2^-23 allowing assimp's fast_atof
+// one ulp. The oracle is the file's text read with strtod in double.
+TEST(MeshLoader, TextCoordinatesCarryOneFloat32Rounding)
+{
+  const std::string path = kTestMeshDir + "/stanford/bunny.obj";
+  std::ifstream file(path);
+  ASSERT_TRUE(file) << path;
+  std::vector<Eigen::Vector3d> exact;
+  for (std::string line; std::getline(file, line);)
+  {
+    double x, y, z;
+    if (std::sscanf(line.c_str(), "v %lf %lf %lf", &x, &y, &z) == 3)
+      exact.emplace_back(x, y, z);
+  }
+  const drb::TriangleMesh mesh = drb::loadMeshFile(path);
+  ASSERT_EQ(static_cast<std::size_t>(mesh.vertices.cols()), exact.size());
+  // Pair each loaded vertex with its file vertex through the float32 rounding
+  // of the file's value (a one-ulp parse difference falls back to a scan).
+  std::map<std::array<float, 3>, Eigen::Vector3d> by_rounded;
+  for (const Eigen::Vector3d& p : exact)
+    by_rounded[{ static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()) }] = p;
+  double worst_absolute = 0.0, worst_relative = 0.0;
+  for (Eigen::Index v = 0; v < mesh.vertices.cols(); ++v)
+  {
+    const Eigen::Vector3d loaded = mesh.vertices.col(v);
+    const auto found = by_rounded.find(
+        { static_cast<float>(loaded.x()), static_cast<float>(loaded.y()), static_cast<float>(loaded.z()) });
+    Eigen::Vector3d file_value = found != by_rounded.end() ? found->second : exact.front();
+    if (found == by_rounded.end())
+      for (const Eigen::Vector3d& p : exact)
+        if ((p - loaded).norm() < (file_value - loaded).norm())
+          file_value = p;
+    for (int k = 0; k < 3; ++k)
+    {
+      const double error = std::abs(loaded[k] - file_value[k]);
+      worst_absolute = std::max(worst_absolute, error);
+      if (file_value[k] != 0.0)
+        worst_relative = std::max(worst_relative, error / std::abs(file_value[k]));
+      EXPECT_LE(error, std::ldexp(std::abs(file_value[k]), -23)) << "vertex " << v << " coordinate " << k;
+    }
+  }
+  std::printf("[measured] bunny.obj (%zu vertices, text): float32 rounding of positions: max %.3g m, max %.3g "
+              "relative (2^-24 = %.3g)\n",
+              exact.size(), worst_absolute, worst_relative, std::ldexp(1.0, -24));
+  EXPECT_GT(worst_absolute, 0.0) << "no rounding at all: positions are no longer float32 (update the README)";
 }
