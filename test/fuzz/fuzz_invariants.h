@@ -32,7 +32,7 @@ inline void requireAllFinite(const double* values, std::size_t count, const std:
       violated(what + "[" + std::to_string(i) + "] is not finite");
 }
 
-/// Every loaded scene: at least one body; finite mass > 0, finite
+/// Every loaded scene: at least one body; finite mass >= 0, finite
 /// symmetric inertia, finite COM, vertices and initial state; finite static
 /// link poses.
 inline void requireValidScene(const drb::Scene& scene)
@@ -42,8 +42,9 @@ inline void requireValidScene(const drb::Scene& scene)
   {
     const drb::RigidBody& body = scene_body.body;
     const std::string where = "body '" + body.name + "': ";
-    require(std::isfinite(body.mass) && body.mass > 0.0, where + "mass not finite and > 0");
-    require(std::isnormal(body.mass), where + "subnormal mass");
+    // Massless bodies load (with a warning); a massive one has a normal mass.
+    require(std::isfinite(body.mass) && body.mass >= 0.0, where + "mass not finite and >= 0");
+    require(body.mass == 0.0 || std::isnormal(body.mass), where + "subnormal mass");
     require(body.inertia_body.allFinite(), where + "inertia not finite");
     require(body.com_offset.allFinite(), where + "COM offset not finite");
     require(body.vertices.allFinite(), where + "vertices not finite");
