@@ -126,7 +126,6 @@ RigidBodyServer::RigidBodyServer(ros::NodeHandle& nh, ros::NodeHandle& private_n
   services_.push_back(
       private_nh.advertiseService("get_vertex_jacobians", &RigidBodyServer::getVertexJacobians, this));
   services_.push_back(private_nh.advertiseService("backprop", &RigidBodyServer::backprop, this));
-  // --- Benchmarks / reduced transport (bench/): begin
   services_.push_back(private_nh.advertiseService("get_vertex_jacobians_compact",
                                                   &RigidBodyServer::getVertexJacobiansCompact, this));
   if (private_nh.param("benchmark_services", false))
@@ -134,7 +133,6 @@ RigidBodyServer::RigidBodyServer(ros::NodeHandle& nh, ros::NodeHandle& private_n
     services_.push_back(private_nh.advertiseService("ping", &RigidBodyServer::ping, this));
     services_.push_back(private_nh.advertiseService("echo", &RigidBodyServer::echo, this));
   }
-  // --- Benchmarks / reduced transport (bench/): end
   set_states_subscriber_ = private_nh.subscribe("set_states", 100, &RigidBodyServer::onSetStates, this,
                                                 ros::TransportHints().tcpNoDelay());
   timer_ = private_nh.createTimer(ros::Duration(1.0 / settings.publish_rate), &RigidBodyServer::onTimer, this);
@@ -331,7 +329,7 @@ void RigidBodyServer::onTimer(const ros::TimerEvent&)
   publishState(ros::Time::now(), /*state_changed=*/false);
 }
 
-// --- Benchmarks / reduced transport (bench/): begin
+// Reduced transport, and the ~benchmark_services ~ping and ~echo (bench/).
 bool RigidBodyServer::getVertexJacobiansCompact(GetVertexJacobiansCompact::Request& request,
                                                 GetVertexJacobiansCompact::Response& response)
 {
@@ -358,6 +356,4 @@ bool RigidBodyServer::echo(Echo::Request& request, Echo::Response& response)
     response.data.resize(request.response_size);
   });
 }
-// --- Benchmarks / reduced transport (bench/): end
-
 }  // namespace diff_rigid_body
