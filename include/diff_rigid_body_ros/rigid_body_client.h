@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -29,6 +30,7 @@
 #include <diff_rigid_body/GetMassMatrix.h>
 #include <diff_rigid_body/GetState.h>
 #include <diff_rigid_body/GetVertexJacobians.h>
+#include <diff_rigid_body/GetVertexJacobiansCompact.h>
 #include <diff_rigid_body/SetState.h>
 
 namespace diff_rigid_body_ros
@@ -107,6 +109,19 @@ struct VertexJacobians
   StackedJacobians J;          ///< 3N x 6; J.middleRows<3>(3 * v) = dp_v/dq
 
   Eigen::Matrix<double, 3, 6> jacobian(Eigen::Index v) const { return J.middleRows<3>(3 * v); }
+};
+
+/// get_vertex_jacobians_compact, in Scalar = double or float (the float32
+/// transport: the double values rounded to float32). J_v = [ Jr_v | I3 ]:
+/// only the rotation block Jr_v = dp_v/d(phi, theta, psi) is sent.
+template <typename Scalar>
+struct VertexRotationJacobians
+{
+  using StackedRotationJacobians = Eigen::Matrix<Scalar, Eigen::Dynamic, 3, Eigen::RowMajor>;
+  Eigen::Matrix<Scalar, 3, Eigen::Dynamic> positions;  ///< [m] column v = vertex v in the fixed frame
+  StackedRotationJacobians Jr;  ///< 3N x 3; Jr.middleRows<3>(3 * v) = Jr_v; 0 x 3 with positions_only
+
+  Eigen::Matrix<Scalar, 3, 3> rotationJacobian(Eigen::Index v) const { return Jr.template middleRows<3>(3 * v); }
 };
 
 class RigidBodyClient
@@ -275,6 +290,43 @@ public:
     return backprop(body, gradients, &q, vertices);
   }
 
+  /// The reduced transport of vertexJacobians: positions and the rotation
+  /// blocks Jr (none with `positions_only`) of `body`'s `vertices` (empty =
+  /// all) at `q` (nullptr = the current state). Scalar = float asks the node
+  /// for the float32 fields (single_precision).
+  template <typename Scalar = double>
+  VertexRotationJacobians<Scalar> vertexJacobiansCompact(const std::string& body, const Vector6d* q = nullptr,
+                                                         const std::vector<std::uint32_t>& vertices = {},
+                                                         bool positions_only = false)
+  {
+    static_assert(std::is_same<Scalar, double>::value || std::is_same<Scalar, float>::value,
+                  "vertexJacobiansCompact: Scalar is double or float");
+    diff_rigid_body::GetVertexJacobiansCompact srv;
+    srv.request.body = body;
+    srv.request.vertices = vertices;
+    if (q)
+      srv.request.q.assign(q->data(), q->data() + 6);
+    srv.request.positions_only = positions_only;
+    srv.request.single_precision = std::is_same<Scalar, float>::value;
+    call(get_vertex_jacobians_compact_, "get_vertex_jacobians_compact", srv);
+    const auto& r = srv.response;
+    const std::vector<Scalar>& positions = compactField<Scalar>(r.positions, r.positions_f32);
+    const std::vector<Scalar>& jacobians = compactField<Scalar>(r.rotation_jacobians, r.rotation_jacobians_f32);
+    const Eigen::Index n = static_cast<Eigen::Index>(positions.size() / 3);
+    VertexRotationJacobians<Scalar> out;
+    out.positions = Eigen::Map<const Eigen::Matrix<Scalar, 3, Eigen::Dynamic>>(positions.data(), 3, n);
+    out.Jr = Eigen::Map<const typename VertexRotationJacobians<Scalar>::StackedRotationJacobians>(
+        jacobians.data(), static_cast<Eigen::Index>(jacobians.size() / 3), 3);
+    return out;
+  }
+  template <typename Scalar = double>
+  VertexRotationJacobians<Scalar> vertexJacobiansCompact(const std::string& body, const Vector6d& q,
+                                                         const std::vector<std::uint32_t>& vertices = {},
+                                                         bool positions_only = false)
+  {
+    return vertexJacobiansCompact<Scalar>(body, &q, vertices, positions_only);
+  }
+
   const std::string& server() const { return server_; }
 
 private:
@@ -304,10 +356,21 @@ private:
       throw ServiceError(server_ + "/" + service, srv.response.message);
   }
 
+  /// The float64 or the float32 field of a compact response.
+  template <typename Scalar>
+  static const std::vector<Scalar>& compactField(const std::vector<double>& f64, const std::vector<float>& f32)
+  {
+    if constexpr (std::is_same<Scalar, float>::value)
+      return f32;
+    else
+      return f64;
+  }
+
   ros::NodeHandle nh_;
   std::string server_;
   ros::Duration timeout_;
-  ros::ServiceClient get_bodies_, set_state_, get_state_, get_mass_matrix_, get_vertex_jacobians_, backprop_;
+  ros::ServiceClient get_bodies_, set_state_, get_state_, get_mass_matrix_, get_vertex_jacobians_, backprop_,
+      get_vertex_jacobians_compact_;
 };
 
 }  // namespace diff_rigid_body_ros

@@ -1,6 +1,7 @@
 """A numpy client for rigid_body_server.
 
-Wraps the node's six services with persistent connections and returns numpy
+Wraps the node's services (those of include/diff_rigid_body_ros/services.h
+that have a client method) with persistent connections and returns numpy
 arrays. Response arrays are deserialised straight from the wire with
 ``np.frombuffer`` (``rospy.numpy_msg``): no per-element Python loop. The
 arrays returned are read-only views on the received buffer; ``.copy()`` one
@@ -8,14 +9,17 @@ to modify it.
 
 Shapes (n bodies, N vertices, K configurations; q = (phi, theta, psi, tx, ty, tz)):
 
-==========================  ===============================================
-``mass_matrix(...).M``      (n, 6, 6), or (K, n, 6, 6) for a batched ``q``
-``mass_matrix(...).dM``     (n, 6, 6, 6): ``dM[i, j]`` = dM/dq_j of body i
-                            (a 6x6 matrix); (K, n, 6, 6, 6) when batched
-``vertex_jacobians(...)``   positions (N, 3) [m], J (N, 3, 6): ``J[v]`` = dp_v/dq
-``backprop(...)``           dL/dq, (6,)
-``get_state()``             dict name -> q (6,)
-==========================  ===============================================
+==============================  ===============================================
+``mass_matrix(...).M``          (n, 6, 6), or (K, n, 6, 6) for a batched ``q``
+``mass_matrix(...).dM``         (n, 6, 6, 6): ``dM[i, j]`` = dM/dq_j of body i
+                                (a 6x6 matrix); (K, n, 6, 6, 6) when batched
+``vertex_jacobians(...)``       positions (N, 3) [m], J (N, 3, 6): ``J[v]`` = dp_v/dq
+``vertex_jacobians_compact()``  positions (N, 3) [m], Jr (N, 3, 3): ``Jr[v]`` =
+                                dp_v/d(phi, theta, psi), J = [Jr | I3]; float32
+                                with ``single_precision``
+``backprop(...)``               dL/dq, (6,)
+``get_state()``                 dict name -> q (6,)
+==============================  ===============================================
 
 A service that answers ``success: False`` raises :class:`DiffRigidBodyError`
 with the node's message. If a persistent connection drops (the node was
@@ -32,7 +36,8 @@ import rospy
 from rospy.numpy_msg import numpy_msg
 
 from diff_rigid_body.msg import BodyState
-from diff_rigid_body.srv import Backprop, GetBodies, GetMassMatrix, GetState, GetVertexJacobians, SetState
+from diff_rigid_body.srv import (Backprop, GetBodies, GetMassMatrix, GetState, GetVertexJacobians,
+                                 GetVertexJacobiansCompact, SetState)
 
 __all__ = ['DiffRigidBodyError', 'RigidBodyClient', 'Bodies', 'MassMatrices']
 
@@ -133,6 +138,7 @@ class RigidBodyClient(object):
         'get_mass_matrix': GetMassMatrix,
         'get_vertex_jacobians': GetVertexJacobians,
         'backprop': Backprop,
+        'get_vertex_jacobians_compact': GetVertexJacobiansCompact,
     }
 
     def __init__(self, server='rigid_body_server', timeout=30.0):
@@ -173,7 +179,7 @@ class RigidBodyClient(object):
 
     def connect(self, services=None):
         """Opens the persistent connections now (``services``: names, None =
-        all six), so that the first calls do not pay for the set-up."""
+        all of SERVICES), so that the first calls do not pay for the set-up."""
         for name in services or self.SERVICES:
             self._proxy(name)
         return self
@@ -233,6 +239,20 @@ class RigidBodyClient(object):
         ``vertices`` (None = all) at ``q`` (None = current state, else (6,))."""
         r = self.call('get_vertex_jacobians', body=body, vertices=_indices(vertices), q=_pose(q))
         return np.asarray(r.positions).reshape(-1, 3), np.asarray(r.jacobians).reshape(-1, 3, 6)
+
+    def vertex_jacobians_compact(self, body, q=None, vertices=None, positions_only=False, single_precision=False):
+        """The reduced transport of :meth:`vertex_jacobians`: positions (N, 3) [m]
+        and the rotation blocks Jr (N, 3, 3), ``Jr[v]`` = dp_v/d(phi, theta, psi)
+        (J = [Jr | I3]); Jr is None with ``positions_only``. With
+        ``single_precision`` both are float32 (the float64 values rounded)."""
+        r = self.call('get_vertex_jacobians_compact', body=body, vertices=_indices(vertices), q=_pose(q),
+                      positions_only=bool(positions_only), single_precision=bool(single_precision))
+        if single_precision:
+            positions, jacobians = r.positions_f32, r.rotation_jacobians_f32
+        else:
+            positions, jacobians = r.positions, r.rotation_jacobians
+        positions = np.asarray(positions).reshape(-1, 3)
+        return positions, None if positions_only else np.asarray(jacobians).reshape(-1, 3, 3)
 
     def positions(self, body, q=None, vertices=None):
         """positions (N, 3) [m] only (the same service; J is discarded)."""

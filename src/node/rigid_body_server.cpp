@@ -119,20 +119,16 @@ RigidBodyServer::RigidBodyServer(ros::NodeHandle& nh, ros::NodeHandle& private_n
   publishStaticLinks();
   publishState(ros::Time::now(), /*state_changed=*/true);
 
-  services_.push_back(private_nh.advertiseService("get_bodies", &RigidBodyServer::getBodies, this));
-  services_.push_back(private_nh.advertiseService("set_state", &RigidBodyServer::setState, this));
-  services_.push_back(private_nh.advertiseService("get_state", &RigidBodyServer::getState, this));
-  services_.push_back(private_nh.advertiseService("get_mass_matrix", &RigidBodyServer::getMassMatrix, this));
-  services_.push_back(
-      private_nh.advertiseService("get_vertex_jacobians", &RigidBodyServer::getVertexJacobians, this));
-  services_.push_back(private_nh.advertiseService("backprop", &RigidBodyServer::backprop, this));
-  services_.push_back(private_nh.advertiseService("get_vertex_jacobians_compact",
-                                                  &RigidBodyServer::getVertexJacobiansCompact, this));
-  if (private_nh.param("benchmark_services", false))
-  {
-    services_.push_back(private_nh.advertiseService("ping", &RigidBodyServer::ping, this));
-    services_.push_back(private_nh.advertiseService("echo", &RigidBodyServer::echo, this));
-  }
+  // Every service of the registry (the handler must take its srv type); the benchmark-only ones
+  // with ~benchmark_services.
+  const bool benchmark_services = private_nh.param("benchmark_services", false);
+#define DRB_ADVERTISE(name, srv_type, handler, python_method, cpp_method, benchmark_only)                              \
+  if (!(benchmark_only) || benchmark_services)                                                                         \
+    services_.push_back(private_nh.advertiseService<RigidBodyServer, srv_type::Request, srv_type::Response>(       \
+        #name, &RigidBodyServer::handler, this));
+  DIFF_RIGID_BODY_SERVICES(DRB_ADVERTISE)
+#undef DRB_ADVERTISE
+  // After the services: a client that sees ~set_states subscribed sees every service.
   set_states_subscriber_ = private_nh.subscribe("set_states", 100, &RigidBodyServer::onSetStates, this,
                                                 ros::TransportHints().tcpNoDelay());
   timer_ = private_nh.createTimer(ros::Duration(1.0 / settings.publish_rate), &RigidBodyServer::onTimer, this);
@@ -329,7 +325,7 @@ void RigidBodyServer::onTimer(const ros::TimerEvent&)
   publishState(ros::Time::now(), /*state_changed=*/false);
 }
 
-// Reduced transport, and the ~benchmark_services ~ping and ~echo (bench/).
+// Reduced transport of get_vertex_jacobians; ~ping and ~echo (benchmark only) measure transport (bench/).
 bool RigidBodyServer::getVertexJacobiansCompact(GetVertexJacobiansCompact::Request& request,
                                                 GetVertexJacobiansCompact::Response& response)
 {

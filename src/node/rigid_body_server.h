@@ -32,20 +32,11 @@
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_broadcaster.h>
 
-#include <diff_rigid_body/Backprop.h>
 #include <diff_rigid_body/BodyStateArray.h>
-#include <diff_rigid_body/GetBodies.h>
-#include <diff_rigid_body/GetMassMatrix.h>
-#include <diff_rigid_body/GetState.h>
-#include <diff_rigid_body/GetVertexJacobians.h>
-#include <diff_rigid_body/SetState.h>
-// Benchmarks and reduced transport (bench/):
-#include <diff_rigid_body/Echo.h>
-#include <diff_rigid_body/GetVertexJacobiansCompact.h>
-#include <diff_rigid_body/Ping.h>
 #include <geometry_msgs/TransformStamped.h>
 
 #include "diff_rigid_body/scene_queries.h"
+#include "diff_rigid_body_ros/services.h"
 
 namespace diff_rigid_body
 {
@@ -89,13 +80,13 @@ private:
   void publishState(const ros::Time& stamp, bool state_changed);
   void publishStaticLinks();
 
+  // The service handlers, one per entry of DIFF_RIGID_BODY_SERVICES (diff_rigid_body_ros/services.h).
   bool getBodies(GetBodies::Request& request, GetBodies::Response& response);
   bool setState(SetState::Request& request, SetState::Response& response);
   bool getState(GetState::Request& request, GetState::Response& response);
   bool getMassMatrix(GetMassMatrix::Request& request, GetMassMatrix::Response& response);
   bool getVertexJacobians(GetVertexJacobians::Request& request, GetVertexJacobians::Response& response);
   bool backprop(Backprop::Request& request, Backprop::Response& response);
-  // Reduced transport (always on) and, with ~benchmark_services, ~ping / ~echo (bench/).
   bool getVertexJacobiansCompact(GetVertexJacobiansCompact::Request& request,
                                  GetVertexJacobiansCompact::Response& response);
   bool ping(Ping::Request& request, Ping::Response& response);

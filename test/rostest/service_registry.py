@@ -1,0 +1,188 @@
+#!/usr/bin/python3
+"""The service registry (include/diff_rigid_body_ros/services.h) against
+everything that must agree with it (service_registry.test):
+
+- the running node advertises exactly the registry's services: without
+  ~benchmark_services the others, with it all of them;
+- every srv type is a file in srv/, listed in CMakeLists.txt's
+  add_service_files and included by services.h;
+- the Python client (RigidBodyClient) has each service in SERVICES, with its
+  srv type, and a method that calls it;
+- the C++ client header declares each C++ method, and calls the service with
+  its srv type;
+- README.md has a row for each service in its Services table (and none for a
+  service that is not in the registry), a row for each Python method in the
+  Python client's method table and one for each C++ method in the C++ one.
+A service without a client method (`none`) must be benchmark-only.
+"""
+import inspect
+import os
+import re
+import time
+import unittest
+
+import rosgraph
+import rospkg
+import rostest
+
+from diff_rigid_body.client import RigidBodyClient
+
+PKG = 'diff_rigid_body'
+SERVER = '/rigid_body_server'              # ~benchmark_services unset
+BENCH_SERVER = '/rigid_body_server_bench'  # ~benchmark_services:=true
+WAIT = 60.0                                # [s] for the nodes to come up
+ROSCPP_SERVICES = {'get_loggers', 'set_logger_level'}  # roscpp's own, on every node
+
+ENTRY = re.compile(r'^\s*X\(\s*(\w+)\s*,\s*(\w+)\s*,\s*(\w+)\s*,\s*(\w+)\s*,\s*(\w+)\s*,\s*(true|false)\s*\)', re.M)
+FIELDS = ('name', 'srv_type', 'handler', 'python_method', 'cpp_method', 'benchmark_only')
+
+
+def package_file(*parts):
+    return os.path.join(rospkg.RosPack().get_path(PKG), *parts)
+
+
+def read(*parts):
+    with open(package_file(*parts)) as f:
+        return f.read()
+
+
+def registry():
+    """The entries of DIFF_RIGID_BODY_SERVICES, as dicts, in order."""
+    text = read('include', 'diff_rigid_body_ros', 'services.h')
+    body = text[text.index('#define DIFF_RIGID_BODY_SERVICES'):]
+    entries = [dict(zip(FIELDS, match)) for match in ENTRY.findall(body)]
+    for entry in entries:
+        entry['benchmark_only'] = entry['benchmark_only'] == 'true'
+    return entries
+
+
+def markdown_section(text, heading):
+    """The lines of `text` from the line `heading` to the next heading of the same or a higher level."""
+    lines = text.splitlines()
+    start = lines.index(heading)
+    level = len(heading) - len(heading.lstrip('#'))
+    in_code = False
+    for end in range(start + 1, len(lines)):
+        if lines[end].startswith('```'):
+            in_code = not in_code
+        stripped = lines[end].lstrip('#')
+        if not in_code and lines[end].startswith('#') and len(lines[end]) - len(stripped) <= level \
+                and stripped.startswith(' '):
+            return lines[start:end]
+    return lines[start:]
+
+
+def table_keys(lines, pattern):
+    """First-column matches of `pattern` in the markdown table rows among `lines`."""
+    keys = []
+    for line in lines:
+        match = re.match(r'^\|\s*' + pattern, line)
+        if match:
+            keys.append(match.group(1))
+    return keys
+
+
+def advertised(node):
+    """The names (private, without the node's prefix) of the services `node` provides."""
+    _, _, services = rosgraph.Master('/service_registry_test').getSystemState()
+    return {name[len(node) + 1:] for name, providers in services
+            if node in providers and name.startswith(node + '/')} - ROSCPP_SERVICES
+
+
+def wait_until_serving(node):
+    """Waits until `node` has subscribed to ~set_states, which it does after advertising every service."""
+    deadline = time.time() + WAIT
+    topic = node + '/set_states'
+    while time.time() < deadline:
+        _, subscriptions, _ = rosgraph.Master('/service_registry_test').getSystemState()
+        if any(name == topic and node in nodes for name, nodes in subscriptions):
+            return
+        time.sleep(0.1)
+    raise AssertionError('%s did not subscribe to %s within %g s' % (node, topic, WAIT))
+
+
+class ServiceRegistry(unittest.TestCase):
+
+    @classmethod
+    def setUpClass(cls):
+        cls.entries = registry()
+
+    def test_registry_is_well_formed(self):
+        names = [e['name'] for e in self.entries]
+        self.assertGreaterEqual(len(names), 9, 'services.h: fewer entries than the 9 services of srv/: %s' % names)
+        self.assertEqual(len(names), len(set(names)), 'services.h: a service is listed twice: %s' % names)
+        for e in self.entries:
+            for side in ('python_method', 'cpp_method'):
+                if e[side] == 'none':
+                    self.assertTrue(e['benchmark_only'], 'services.h: %s has no %s but is not benchmark-only'
+                                    % (e['name'], side))
+
+    def test_node_advertises_exactly_the_registry(self):
+        for node, with_benchmark in ((SERVER, False), (BENCH_SERVER, True)):
+            wait_until_serving(node)
+            expected = {e['name'] for e in self.entries if with_benchmark or not e['benchmark_only']}
+            actual = advertised(node)
+            self.assertEqual(actual - expected, set(), '%s advertises services not in services.h' % node)
+            self.assertEqual(expected - actual, set(), '%s does not advertise services of services.h' % node)
+
+    def test_srv_files(self):
+        cmake = read('CMakeLists.txt')
+        listed = ' '.join(re.findall(r'add_service_files\(FILES([^)]*)\)', cmake)).split()
+        header = read('include', 'diff_rigid_body_ros', 'services.h')
+        for e in self.entries:
+            srv = e['srv_type'] + '.srv'
+            self.assertTrue(os.path.isfile(package_file('srv', srv)), '%s: srv/%s does not exist' % (e['name'], srv))
+            self.assertIn(srv, listed, '%s: %s is not in add_service_files (CMakeLists.txt)' % (e['name'], srv))
+            self.assertIn('#include <diff_rigid_body/%s.h>' % e['srv_type'], header,
+                          'services.h does not include the srv header of %s' % e['name'])
+
+    def test_python_client_wraps_every_service(self):
+        wrapped = {e['name'] for e in self.entries if e['python_method'] != 'none'}
+        self.assertEqual(set(RigidBodyClient.SERVICES), wrapped,
+                         'RigidBodyClient.SERVICES (client.py) differs from the services.h entries with a python method')
+        for e in self.entries:
+            if e['python_method'] == 'none':
+                continue
+            self.assertEqual(RigidBodyClient.SERVICES[e['name']]._type, '%s/%s' % (PKG, e['srv_type']),
+                             'client.py: SERVICES[%r] has the wrong srv type' % e['name'])
+            method = getattr(RigidBodyClient, e['python_method'], None)
+            self.assertTrue(callable(method), 'client.py: RigidBodyClient has no method %s() for %s'
+                            % (e['python_method'], e['name']))
+            self.assertIn("'%s'" % e['name'], inspect.getsource(method),
+                          'client.py: RigidBodyClient.%s() does not call %s' % (e['python_method'], e['name']))
+
+    def test_cpp_client_wraps_every_service(self):
+        header = read('include', 'diff_rigid_body_ros', 'rigid_body_client.h')
+        for e in self.entries:
+            if e['cpp_method'] == 'none':
+                continue
+            # A line "<return type> method(" (a type may hold spaces and commas; a call starts with return).
+            declaration = r'^[ \t]*(?!return\b)[^;=(/\n]*[\w>&*][ \t]+%s[ \t]*\(' % e['cpp_method']
+            self.assertTrue(re.search(declaration, header, re.M),
+                            'rigid_body_client.h: RigidBodyClient declares no %s() for %s'
+                            % (e['cpp_method'], e['name']))
+            self.assertIn('"%s"' % e['name'], header, 'rigid_body_client.h never calls %s' % e['name'])
+            self.assertIn('diff_rigid_body::%s srv' % e['srv_type'], header,
+                          'rigid_body_client.h never builds a diff_rigid_body::%s for %s' % (e['srv_type'], e['name']))
+
+    def test_readme_services_table(self):
+        rows = table_keys(markdown_section(read('README.md'), '### Services'), r'`~(\w+)`')
+        self.assertEqual(len(rows), len(set(rows)), 'README.md Services table: a service has two rows: %s' % rows)
+        names = {e['name'] for e in self.entries}
+        self.assertEqual(names - set(rows), set(), 'README.md Services table: no row for these services')
+        self.assertEqual(set(rows) - names, set(), 'README.md Services table: rows for services not in services.h')
+
+    def test_readme_client_tables(self):
+        readme = read('README.md')
+        for heading, side, pattern in (('### Python: `diff_rigid_body.client`', 'python_method', r'`(\w+)\('),
+                                       ('### C++: `include/diff_rigid_body_ros/rigid_body_client.h`', 'cpp_method',
+                                        r'`(\w+)(?:<\w+>)?\(')):
+            rows = set(table_keys(markdown_section(readme, heading), pattern))
+            for e in self.entries:
+                if e[side] != 'none':
+                    self.assertIn(e[side], rows, 'README.md, %s: no method-table row for %s() (service %s)'
+                                  % (heading, e[side], e['name']))
+
+
+if __name__ == '__main__':
+    rostest.rosrun(PKG, 'service_registry', ServiceRegistry)
