@@ -14,7 +14,7 @@
 
 #include <Eigen/Core>
 
-#include "diff_rigid_body/vertex_jacobian.h"
+#include "diff_rigid_body/types.h"
 
 namespace diff_rigid_body
 {

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "diff_rigid_body/vertex_jacobian.h"
+#include "diff_rigid_body/types.h"
 
 namespace diff_rigid_body
 {

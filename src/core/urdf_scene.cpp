@@ -16,6 +16,7 @@
 #include "diff_rigid_body/exceptions.h"
 #include "diff_rigid_body/mass_properties.h"
 #include "diff_rigid_body/mesh_loader.h"
+#include "diff_rigid_body/rpy.h"
 
 namespace diff_rigid_body
 {
