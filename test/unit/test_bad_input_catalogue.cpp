@@ -33,8 +33,19 @@
 #include "diff_rigid_body/scene_queries.h"
 #include "diff_rigid_body/state_file.h"
 #include "diff_rigid_body/urdf_scene.h"
+#include "../support/state_files.h"
+#include "../support/urdf_builders.h"
 
 namespace drb = diff_rigid_body;
+using drb_test::replacedOnce;
+using drb_test::reseal;
+using drb_test::withoutTrailer;
+using drb_test::urdf::collision;
+using drb_test::urdf::floatingJoint;
+using drb_test::urdf::inertial;
+using drb_test::urdf::meshGeometry;
+using drb_test::urdf::oneBody;
+using drb_test::urdf::robot;
 
 namespace
 {
@@ -105,43 +116,6 @@ std::string portable(const std::string& message)
   return std::regex_replace(text, std::regex("\\b[0-9a-f]{16}\\b"), "<hash>");
 }
 
-// ---------------------------------------------------------------------------
-// URDF builders.
-
-std::string robot(const std::string& body)
-{
-  return "<?xml version=\"1.0\"?><robot name=\"r\"><link name=\"world\"/>" + body + "</robot>";
-}
-
-std::string inertial(const std::string& mass = "1", const std::vector<std::string>& I = { "0.1", "0", "0", "0.1", "0", "0.1" },
-                     const std::string& origin = "")
-{
-  return "<inertial>" + origin + "<mass value=\"" + mass + "\"/><inertia ixx=\"" + I[0] + "\" ixy=\"" + I[1] +
-         "\" ixz=\"" + I[2] + "\" iyy=\"" + I[3] + "\" iyz=\"" + I[4] + "\" izz=\"" + I[5] + "\"/></inertial>";
-}
-
-std::string floating(const std::string& child, const std::string& origin = "", const std::string& parent = "world")
-{
-  return "<joint name=\"" + child + "_joint\" type=\"floating\"><parent link=\"" + parent + "\"/><child link=\"" +
-         child + "\"/>" + origin + "</joint>";
-}
-
-std::string collision(const std::string& geometry, const std::string& origin = "")
-{
-  return "<collision>" + origin + "<geometry>" + geometry + "</geometry></collision>";
-}
-
-/// One floating body "b" with `inner` inside its <link>.
-std::string oneBody(const std::string& inner, const std::string& joint_origin = "")
-{
-  return robot("<link name=\"b\">" + inner + "</link>" + floating("b", joint_origin));
-}
-
-std::string meshGeometry(const std::string& file, const std::string& scale = "")
-{
-  return "<mesh filename=\"" + file + "\"" + (scale.empty() ? "" : " scale=\"" + scale + "\"") + "/>";
-}
-
 drb::SceneOptions withPackages(drb::SceneOptions options = {})
 {
   options.find_package = [](const std::string& package) {
@@ -207,19 +181,19 @@ std::vector<Row> urdfRows()
     { "U05", "<link> without a name", Expect::Refused, "SceneDescriptionError", "urdfdom rejected it",
       load(robot("<link>" + I + "</link>")) },
     { "U06", "two links with the same name", Expect::Refused, "SceneDescriptionError", "urdfdom rejected it",
-      load(robot("<link name=\"b\">" + I + "</link><link name=\"b\">" + I + "</link>" + floating("b"))) },
+      load(robot("<link name=\"b\">" + I + "</link><link name=\"b\">" + I + "</link>" + floatingJoint("b"))) },
     { "U07", "two joints with the same name", Expect::Refused, "SceneDescriptionError", "urdfdom rejected it",
       load(robot("<link name=\"b\">" + I + "</link><link name=\"c\">" + I + "</link>" +
                  "<joint name=\"j\" type=\"floating\"><parent link=\"world\"/><child link=\"b\"/></joint>" +
                  "<joint name=\"j\" type=\"floating\"><parent link=\"world\"/><child link=\"c\"/></joint>")) },
-    { "U08", "joint whose child link does not exist", Expect::Refused, "SceneDescriptionError",
-      "urdfdom rejected it", load(robot(floating("ghost"))) },
-    { "U09", "joint whose parent link does not exist", Expect::Refused, "SceneDescriptionError",
-      "urdfdom rejected it", load(robot("<link name=\"b\">" + I + "</link>" + floating("b", "", "ghost"))) },
+    { "U08", "joint whose child link does not exist", Expect::Refused, "SceneDescriptionError", "urdfdom rejected it",
+      load(robot(floatingJoint("ghost"))) },
+    { "U09", "joint whose parent link does not exist", Expect::Refused, "SceneDescriptionError", "urdfdom rejected it",
+      load(robot("<link name=\"b\">" + I + "</link>" + floatingJoint("b", "", "ghost"))) },
     { "U10", "two root links (a link joined to nothing)", Expect::Refused, "SceneDescriptionError",
-      "urdfdom rejected it", load(robot("<link name=\"b\">" + I + "</link><link name=\"c\"/>" + floating("b"))) },
+      "urdfdom rejected it", load(robot("<link name=\"b\">" + I + "</link><link name=\"c\"/>" + floatingJoint("b"))) },
     { "U11", "a joint loop (no root link)", Expect::Refused, "SceneDescriptionError", "urdfdom rejected it",
-      load(robot("<link name=\"b\">" + I + "</link>" + floating("b") + floating("world", "", "b"))) },
+      load(robot("<link name=\"b\">" + I + "</link>" + floatingJoint("b") + floatingJoint("world", "", "b"))) },
     { "U12", "no body (only fixed joints)", Expect::Refused, "SceneDescriptionError", "no body",
       load(robot("<link name=\"b\">" + I +
                  "</link><joint name=\"j\" type=\"fixed\"><parent link=\"world\"/><child link=\"b\"/></joint>")) },
@@ -234,15 +208,17 @@ std::vector<Row> urdfRows()
       load(oneBody(I, "<origin rpy=\"0 0 nan\"/>")) },
     { "U17", "joint <origin xyz> with two numbers", Expect::Refused, "SceneDescriptionError", "urdfdom rejected it",
       load(oneBody(I, "<origin xyz=\"1 2\"/>")) },
-    { "U18", "joint <origin xyz> that is not a number", Expect::Refused, "SceneDescriptionError",
-      "urdfdom rejected it", load(oneBody(I, "<origin xyz=\"a b c\"/>")) },
+    { "U18", "joint <origin xyz> that is not a number", Expect::Refused, "SceneDescriptionError", "urdfdom rejected it",
+      load(oneBody(I, "<origin xyz=\"a b c\"/>")) },
     { "U19", "joint origins so far away that the body's position overflows (1e308 + 1e308)", Expect::Refused,
       "SceneDescriptionError", "initial state is not finite",
       load(oneBody(inertial("1", { "0.1", "0", "0", "0.1", "0", "0.1" }, "<origin xyz=\"1e308 0 0\"/>"),
                    "<origin xyz=\"1e308 0 0\"/>")) },
-    { "U20", "<inertial><origin xyz> with NaN", Expect::Refused, "SceneDescriptionError", "Could not parse inertial element for Link [b]",
+    { "U20", "<inertial><origin xyz> with NaN", Expect::Refused, "SceneDescriptionError",
+      "Could not parse inertial element for Link [b]",
       load(oneBody(inertial("1", { "0.1", "0", "0", "0.1", "0", "0.1" }, "<origin xyz=\"0 nan 0\"/>"))) },
-    { "U21", "<inertial><origin rpy> with Inf", Expect::Refused, "SceneDescriptionError", "Could not parse inertial element for Link [b]",
+    { "U21", "<inertial><origin rpy> with Inf", Expect::Refused, "SceneDescriptionError",
+      "Could not parse inertial element for Link [b]",
       load(oneBody(inertial("1", { "0.1", "0", "0", "0.1", "0", "0.1" }, "<origin rpy=\"inf 0 0\"/>"))) },
     { "U22", "mass NaN", Expect::Refused, "SceneDescriptionError", "mass [nan] is not a float",
       load(oneBody(inertial("nan"))) },
@@ -318,8 +294,8 @@ std::vector<Row> urdfRows()
     { "U53", "~density with an open mesh (no volume)", Expect::Refused, "InvalidInertiaError",
       "cannot compute inertia from its geometry",
       load(oneBody(collision(meshGeometry(kMeshDir + "/bad_open_surface.obj"))), density(1000.0)) },
-    { "U54", "box size with NaN", Expect::Refused, "SceneDescriptionError", "Could not parse collision element for Link [b]",
-      load(oneBody(I + collision("<box size=\"nan 1 1\"/>"))) },
+    { "U54", "box size with NaN", Expect::Refused, "SceneDescriptionError",
+      "Could not parse collision element for Link [b]", load(oneBody(I + collision("<box size=\"nan 1 1\"/>"))) },
     { "U55", "box size 0", Expect::Refused, "SceneDescriptionError", "box size y must be finite and > 0",
       load(oneBody(I + collision("<box size=\"1 0 1\"/>"))) },
     { "U56", "box size negative", Expect::Refused, "SceneDescriptionError", "box size z must be finite and > 0",
@@ -332,26 +308,29 @@ std::vector<Row> urdfRows()
       load(oneBody(I + collision("<sphere radius=\"nan\"/>"))) },
     { "U60", "sphere radius 0", Expect::Refused, "SceneDescriptionError", "sphere radius must be finite and > 0",
       load(oneBody(I + collision("<sphere radius=\"0\"/>"))) },
-    { "U61", "sphere radius negative", Expect::Refused, "SceneDescriptionError",
-      "sphere radius must be finite and > 0", load(oneBody(I + collision("<sphere radius=\"-1\"/>"))) },
+    { "U61", "sphere radius negative", Expect::Refused, "SceneDescriptionError", "sphere radius must be finite and > 0",
+      load(oneBody(I + collision("<sphere radius=\"-1\"/>"))) },
     { "U62", "cylinder radius NaN", Expect::Refused, "SceneDescriptionError", "radius [nan]",
       load(oneBody(I + collision("<cylinder radius=\"nan\" length=\"1\"/>"))) },
     { "U63", "cylinder length 0", Expect::Refused, "SceneDescriptionError", "cylinder length must be finite and > 0",
       load(oneBody(I + collision("<cylinder radius=\"1\" length=\"0\"/>"))) },
     { "U64", "cylinder length -Inf", Expect::Refused, "SceneDescriptionError", "length [-inf]",
       load(oneBody(I + collision("<cylinder radius=\"1\" length=\"-inf\"/>"))) },
-    { "U65", "geometry <origin> with NaN", Expect::Refused, "SceneDescriptionError", "Could not parse collision element for Link [b]", load(oneBody(I + collision("<box size=\"1 1 1\"/>",
-                                                                    "<origin xyz=\"0 0 nan\"/>"))) },
+    { "U65", "geometry <origin> with NaN", Expect::Refused, "SceneDescriptionError",
+      "Could not parse collision element for Link [b]",
+      load(oneBody(I + collision("<box size=\"1 1 1\"/>", "<origin xyz=\"0 0 nan\"/>"))) },
     { "U66", "<geometry> without a shape", Expect::Refused, "SceneDescriptionError", "urdfdom rejected it",
       load(oneBody(I + "<collision><geometry/></collision>")) },
     { "U67", "geometry so far out that the vertices overflow", Expect::Refused, "SceneDescriptionError",
       "vertex coordinates overflow",
       load(oneBody(I + collision("<box size=\"1e308 1 1\"/>", "<origin xyz=\"1.7e308 0 0\"/>"))) },
-    { "U68", "mesh scale with NaN", Expect::Refused, "SceneDescriptionError", "Mesh scale was specified, but could not be parsed",
+    { "U68", "mesh scale with NaN", Expect::Refused, "SceneDescriptionError",
+      "Mesh scale was specified, but could not be parsed",
       load(oneBody(I + collision(meshGeometry(kMeshDir + "/tetrahedron.obj", "1 nan 1")))) },
     { "U69", "mesh scale 0", Expect::Refused, "MeshLoadError", "scale must be finite and non-zero",
       load(oneBody(I + collision(meshGeometry(kMeshDir + "/tetrahedron.obj", "1 1 0")))) },
-    { "U70", "mesh scale +Inf", Expect::Refused, "SceneDescriptionError", "Mesh scale was specified, but could not be parsed",
+    { "U70", "mesh scale +Inf", Expect::Refused, "SceneDescriptionError",
+      "Mesh scale was specified, but could not be parsed",
       load(oneBody(I + collision(meshGeometry(kMeshDir + "/tetrahedron.obj", "inf 1 1")))) },
     { "U71", "mesh scale negative (a mirror image)", Expect::Accepted, "", "",
       [] {
@@ -400,7 +379,7 @@ std::vector<Row> urdfRows()
       } },
     { "U79", "a chain of 100 000 fixed links (deep tree)", Expect::Accepted, "", "",
       [I] {
-        std::string body = "<link name=\"b\">" + I + "</link>" + floating("b");
+        std::string body = "<link name=\"b\">" + I + "</link>" + floatingJoint("b");
         std::string parent = "b";
         for (int i = 0; i < 100000; ++i)
         {
@@ -417,7 +396,7 @@ std::vector<Row> urdfRows()
       [I] {
         std::string body;
         for (int i = 0; i < 20000; ++i)
-          body += "<link name=\"b" + std::to_string(i) + "\">" + I + "</link>" + floating("b" + std::to_string(i));
+          body += "<link name=\"b" + std::to_string(i) + "\">" + I + "</link>" + floatingJoint("b" + std::to_string(i));
         const auto start = std::chrono::steady_clock::now();
         const drb::Scene scene = drb::loadSceneFromUrdf(robot(body));
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -486,11 +465,7 @@ std::vector<Row> meshRows()
 
 const drb::SceneQueries& twoBodies()
 {
-  static const drb::SceneQueries queries(drb::loadSceneFromUrdf(robot(
-      "<link name=\"cube\">" + inertial("2", { "0.1", "0.01", "0.02", "0.2", "-0.03", "0.25" }) +
-      collision("<box size=\"0.2 0.2 0.2\"/>") + "</link>" + floating("cube", "<origin xyz=\"0 0 1\"/>") +
-      "<link name=\"ball\">" + inertial("1", { "0.004", "0", "0", "0.004", "0", "0.004" }) +
-      collision("<sphere radius=\"0.1\"/>") + "</link>" + floating("ball", "<origin xyz=\"1 0 1\"/>"))));
+  static const drb::SceneQueries queries(drb::loadSceneFromUrdf(drb_test::urdf::twoBodies()));
   return queries;
 }
 
@@ -755,18 +730,10 @@ std::function<std::string()> parse(const std::string& text)
   };
 }
 
+/// `text` with its trailer recomputed for the two bodies.
 std::string resealed(const std::string& text)
 {
-  const std::string body = text.substr(0, text.rfind("end "));
-  char crc[16];
-  std::snprintf(crc, sizeof crc, "%08x", drb::crc32(body));
-  return body + "end 2 crc32 " + crc + "\n";
-}
-
-std::string replacedOnce(std::string text, const std::string& from, const std::string& to)
-{
-  text.replace(text.find(from), from.size(), to);
-  return text;
+  return reseal(withoutTrailer(text), 2);
 }
 
 // Temporary files of this process; messages show them as "<tmp>/name".
@@ -789,11 +756,9 @@ std::vector<Row> stateFileRows()
   const drb::Scene& scene = twoBodies().scene();
   drb::SceneOptions one;
   one.bodies = { "cube" };
-  const drb::Scene heavier_ball = drb::loadSceneFromUrdf(
-      robot("<link name=\"cube\">" + inertial("2", { "0.1", "0.01", "0.02", "0.2", "-0.03", "0.25" }) +
-            collision("<box size=\"0.2 0.2 0.2\"/>") + "</link>" + floating("cube", "<origin xyz=\"0 0 1\"/>") +
-            "<link name=\"ball\">" + inertial("1.5", { "0.004", "0", "0", "0.004", "0", "0.004" }) +
-            collision("<sphere radius=\"0.1\"/>") + "</link>" + floating("ball", "<origin xyz=\"1 0 1\"/>")));
+  drb_test::urdf::TwoBodies heavier;
+  heavier.ball_mass = "1.5";
+  const drb::Scene heavier_ball = drb::loadSceneFromUrdf(drb_test::urdf::twoBodies(heavier));
   return {
     { "S01", "no file yet", Expect::Accepted, "", "",
       [] {
@@ -810,21 +775,20 @@ std::vector<Row> stateFileRows()
     { "S06", "one flipped bit", Expect::Refused, "StateFileError", "checksum mismatch", parse(flipped) },
     { "S07", "malformed trailer", Expect::Refused, "StateFileError", "expected 'end <count> crc32",
       parse(replacedOnce(good, "crc32", "md5")) },
-    { "S08", "body count that disagrees (checksum fixed up)", Expect::Refused, "StateFileError",
-      "body count mismatch", parse(resealed(replacedOnce(good, "bodies 2", "bodies 3"))) },
+    { "S08", "body count that disagrees (checksum fixed up)", Expect::Refused, "StateFileError", "body count mismatch",
+      parse(resealed(replacedOnce(good, "bodies 2", "bodies 3"))) },
     { "S09", "body line with too few values (checksum fixed up)", Expect::Refused, "StateFileError",
-      "expected 'body <name> <6 hex floats>'",
-      parse(resealed(replacedOnce(good, " 0x1p+1\n", "\n"))) },
+      "expected 'body <name> <6 hex floats>'", parse(resealed(replacedOnce(good, " 0x1p+1\n", "\n"))) },
     { "S10", "malformed percent-encoded name (checksum fixed up)", Expect::Refused, "StateFileError",
       "malformed body name", parse(resealed(replacedOnce(good, "body ball", "body ba%G1"))) },
-    { "S11", "decimal instead of a hex float (checksum fixed up)", Expect::Refused, "StateFileError",
-      "not a hex float", parse(resealed(replacedOnce(good, "body cube 0x1p-1", "body cube 0.5"))) },
+    { "S11", "decimal instead of a hex float (checksum fixed up)", Expect::Refused, "StateFileError", "not a hex float",
+      parse(resealed(replacedOnce(good, "body cube 0x1p-1", "body cube 0.5"))) },
     { "S12", "non-finite value (checksum fixed up)", Expect::Refused, "StateFileError", "not finite",
       parse(resealed(replacedOnce(good, "body cube 0x1p-1", "body cube 0xinf"))) },
     { "S13", "saved for other bodies", Expect::Refused, "StateFileError", "saved for other bodies",
       [=] {
         drb::parseStateFile(drb::formatStateFile(drb::loadSceneFromUrdf(robot("<link name=\"cube\">" + inertial() +
-                                                                              "</link>" + floating("cube")),
+                                                                              "</link>" + floatingJoint("cube")),
                                                                         one),
                                                  { drb::Vector6<double>::Zero() }),
                             scene);
@@ -836,8 +800,7 @@ std::vector<Row> stateFileRows()
                             scene);
         return std::string("accepted");
       } },
-    { "S15", "data after the trailer", Expect::Refused, "StateFileError", "no 'end' line",
-      parse(good + "extra\n") },
+    { "S15", "data after the trailer", Expect::Refused, "StateFileError", "no 'end' line", parse(good + "extra\n") },
     { "S16", "CRLF line ends (checksum fixed up)", Expect::Refused, "StateFileError", "line 3: expected",
       parse(resealed(replacedOnce(good, "bodies 2\n", "bodies 2\r\n"))) },
     { "S17", "file larger than 64 KiB + 4 KiB per body", Expect::Refused, "StateFileError", "too large",

@@ -22,7 +22,7 @@
 
 #include "diff_rigid_body/mass_matrix.h"
 #include "diff_rigid_body/vertex_jacobian.h"
-#include "oracles.h"
+#include "../support/oracles.h"
 
 namespace drb = diff_rigid_body;
 using namespace drb_test;

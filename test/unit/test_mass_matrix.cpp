@@ -27,7 +27,7 @@
 
 #include "diff_rigid_body/mass_matrix.h"
 #include "diff_rigid_body/vertex_jacobian.h"
-#include "oracles.h"
+#include "../support/oracles.h"
 
 namespace drb = diff_rigid_body;
 using namespace drb_test;
@@ -151,13 +151,7 @@ std::vector<Body> hardBodies(Random& rng)
 
 std::vector<Vector6<double>> hardStates(Random& rng)
 {
-  std::vector<Vector6<double>> states;
-  for (const double theta : gimbalLockThetas())
-  {
-    Vector6<double> q = rng.state();
-    q[1] = theta;
-    states.push_back(q);
-  }
+  std::vector<Vector6<double>> states = gimbalLockStates(rng);
   for (const double a : largeAngles())
     for (int axis = 0; axis < 3; ++axis)
     {

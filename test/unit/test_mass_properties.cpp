@@ -27,6 +27,7 @@
 
 #include "diff_rigid_body/exceptions.h"
 #include "diff_rigid_body/mass_properties.h"
+#include "../support/expect_throws.h"
 
 using diff_rigid_body::boxMassProperties;
 using diff_rigid_body::combineMassProperties;
@@ -289,20 +290,6 @@ Eigen::Matrix3d inertiaAboutCom(const Eigen::Matrix3d& second_about_origin, doub
   return S.trace() * Eigen::Matrix3d::Identity() - S;
 }
 
-template <typename Fn>
-void expectThrowsWith(Fn&& fn, const std::string& fragment)
-{
-  try
-  {
-    fn();
-    ADD_FAILURE() << "no exception, expected one mentioning '" << fragment << "'";
-  }
-  catch (const std::exception& e)
-  {
-    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
-  }
-}
-
 }  // namespace
 
 // ===========================================================================
@@ -383,20 +370,21 @@ TEST(MassPropertiesComposite, RejectsBadParts)
   const MassProperties good = boxMassProperties(1.0, Eigen::Vector3d::Ones());
   const Eigen::Isometry3d I = Eigen::Isometry3d::Identity();
   EXPECT_THROW(combineMassProperties({}, "link 'base'"), InvalidInertiaError);
-  expectThrowsWith([&] { combineMassProperties({}, "link 'base'"); }, "link 'base'");
+  DRB_EXPECT_THROWS_MESSAGE((combineMassProperties({}, "link 'base'")), std::exception, "link 'base'");
   MassProperties negative = good;
   negative.mass = -1.0;
   EXPECT_THROW(combineMassProperties({ { I, good }, { I, negative } }), InvalidInertiaError);
-  expectThrowsWith([&] { combineMassProperties({ { I, good }, { I, negative } }, "link 'arm'"); }, "part 1");
+  DRB_EXPECT_THROWS_MESSAGE((combineMassProperties({ { I, good }, { I, negative } }, "link 'arm'")), std::exception,
+                            "part 1");
   MassProperties nan_com = good;
   nan_com.com.x() = std::numeric_limits<double>::quiet_NaN();
-  expectThrowsWith([&] { combineMassProperties({ { I, nan_com } }); }, "COM must be finite");
+  DRB_EXPECT_THROWS_MESSAGE((combineMassProperties({ { I, nan_com } })), std::exception, "COM must be finite");
   MassProperties massless = good;
   massless.mass = 0.0;
-  expectThrowsWith([&] { combineMassProperties({ { I, massless } }); }, "total mass");
+  DRB_EXPECT_THROWS_MESSAGE((combineMassProperties({ { I, massless } })), std::exception, "total mass");
   Eigen::Isometry3d scaled = I;
   scaled.linear() *= 2.0;
-  expectThrowsWith([&] { combineMassProperties({ { scaled, good } }); }, "orthonormal");
+  DRB_EXPECT_THROWS_MESSAGE((combineMassProperties({ { scaled, good } })), std::exception, "orthonormal");
 }
 
 // ===========================================================================
@@ -488,8 +476,8 @@ TEST(MassPropertiesPrimitives, RejectNonPositiveOrNonFiniteArguments)
   EXPECT_THROW(sphereMassProperties(1.0, 0.0), InvalidArgumentError);
   EXPECT_THROW(cylinderMassProperties(-1.0, 1.0, 1.0), InvalidArgumentError);
   EXPECT_THROW(cylinderMassProperties(1.0, 1.0, std::numeric_limits<double>::infinity()), InvalidArgumentError);
-  expectThrowsWith([&] { boxMassProperties(1.0, Eigen::Vector3d(1, -1, 1)); }, "size y");
-  expectThrowsWith([&] { sphereMassProperties(nan, 1.0); }, "density");
+  DRB_EXPECT_THROWS_MESSAGE((boxMassProperties(1.0, Eigen::Vector3d(1, -1, 1))), std::exception, "size y");
+  DRB_EXPECT_THROWS_MESSAGE((sphereMassProperties(nan, 1.0)), std::exception, "density");
 }
 
 // ===========================================================================
@@ -650,37 +638,39 @@ TEST(MassPropertiesMesh, RejectsBadMeshesAndDensities)
     EXPECT_THROW(meshMassProperties(density, box), InvalidArgumentError) << density;
     EXPECT_THROW(particleMassProperties(density, box, 1000), InvalidArgumentError) << density;
   }
-  expectThrowsWith([&] { meshMassProperties(nan, box, "link 'wheel'"); }, "link 'wheel': density");
+  DRB_EXPECT_THROWS_MESSAGE((meshMassProperties(nan, box, "link 'wheel'")), std::exception, "link 'wheel': density");
   // Empty.
-  expectThrowsWith([&] { meshMassProperties(1.0, TriangleMesh(), "link 'e'"); }, "link 'e': mesh has no vertices");
+  DRB_EXPECT_THROWS_MESSAGE((meshMassProperties(1.0, TriangleMesh(), "link 'e'")), std::exception,
+                            "link 'e': mesh has no vertices");
   TriangleMesh no_triangles = box;
   no_triangles.triangles.clear();
-  expectThrowsWith([&] { meshMassProperties(1.0, no_triangles); }, "no triangles");
+  DRB_EXPECT_THROWS_MESSAGE((meshMassProperties(1.0, no_triangles)), std::exception, "no triangles");
   EXPECT_THROW(meshMassProperties(1.0, TriangleMesh()), MeshLoadError);
   // Zero volume: a box squashed flat (closed, every triangle still used
   // twice) and a "pillow" of one triangle glued to its reverse.
   TriangleMesh flat = box;
   flat.vertices.row(2).setZero();
-  expectThrowsWith([&] { meshMassProperties(1.0, flat, "link 'flat'"); }, "link 'flat': closed mesh encloses no volume");
+  DRB_EXPECT_THROWS_MESSAGE((meshMassProperties(1.0, flat, "link 'flat'")), std::exception,
+                            "link 'flat': closed mesh encloses no volume");
   EXPECT_THROW(particleMassProperties(1.0, flat, 1000), MeshLoadError);
   TriangleMesh pillow = makeMesh({ { 0, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 } }, { { 0, 1, 2 }, { 0, 2, 1 } });
   EXPECT_THROW(meshMassProperties(1.0, pillow), MeshLoadError);
   // Open: one triangle missing.
   TriangleMesh open = box;
   open.triangles.pop_back();
-  expectThrowsWith([&] { meshMassProperties(1.0, open); }, "not closed");
+  DRB_EXPECT_THROWS_MESSAGE((meshMassProperties(1.0, open)), std::exception, "not closed");
   EXPECT_THROW(particleMassProperties(1.0, open, 1000), MeshLoadError);
   // Inconsistently oriented: one triangle flipped.
   TriangleMesh flipped = box;
   std::swap(flipped.triangles[3][1], flipped.triangles[3][2]);
-  expectThrowsWith([&] { meshMassProperties(1.0, flipped); }, "not closed and consistently oriented");
+  DRB_EXPECT_THROWS_MESSAGE((meshMassProperties(1.0, flipped)), std::exception, "not closed and consistently oriented");
   // Bad index and non-finite vertex.
   TriangleMesh bad_index = box;
   bad_index.triangles[5][2] = 8;
-  expectThrowsWith([&] { meshMassProperties(1.0, bad_index); }, "triangle 5 refers to vertex 8");
+  DRB_EXPECT_THROWS_MESSAGE((meshMassProperties(1.0, bad_index)), std::exception, "triangle 5 refers to vertex 8");
   TriangleMesh bad_vertex = box;
   bad_vertex.vertices(1, 6) = nan;
-  expectThrowsWith([&] { meshMassProperties(1.0, bad_vertex); }, "vertex 6 is not finite");
+  DRB_EXPECT_THROWS_MESSAGE((meshMassProperties(1.0, bad_vertex)), std::exception, "vertex 6 is not finite");
   // Particles: zero target.
   EXPECT_THROW(particleMassProperties(1.0, box, 0), InvalidArgumentError);
 }

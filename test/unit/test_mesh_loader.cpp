@@ -6,10 +6,12 @@
 #include <map>
 #include <string>
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include "diff_rigid_body/exceptions.h"
 #include "diff_rigid_body/mesh_loader.h"
+#include "../support/expect_throws.h"
 
 namespace drb = diff_rigid_body;
 
@@ -87,27 +89,10 @@ TEST(MeshLoader, AsciiPly)
 
 TEST(MeshLoader, ClearErrors)
 {
-  try
-  {
-    drb::loadMeshFile("/nonexistent/part.stl");
-    FAIL();
-  }
-  catch (const drb::MeshLoadError& e)
-  {
-    EXPECT_NE(std::string(e.what()).find("/nonexistent/part.stl"), std::string::npos) << e.what();
-  }
+  DRB_EXPECT_THROWS_MESSAGE(drb::loadMeshFile("/nonexistent/part.stl"), drb::MeshLoadError, "/nonexistent/part.stl");
   for (const Eigen::Vector3d& scale : { Eigen::Vector3d(0, 1, 1), Eigen::Vector3d(1, NAN, 1) })
-  {
-    try
-    {
-      drb::loadMeshFile(kTestMeshDir + "/tetrahedron.obj", scale);
-      FAIL();
-    }
-    catch (const drb::MeshLoadError& e)
-    {
-      EXPECT_NE(std::string(e.what()).find("scale must be finite and non-zero"), std::string::npos) << e.what();
-    }
-  }
+    DRB_EXPECT_THROWS_MESSAGE(drb::loadMeshFile(kTestMeshDir + "/tetrahedron.obj", scale), drb::MeshLoadError,
+                              "scale must be finite and non-zero");
   const std::string empty = ::testing::TempDir() + "drb_empty.obj";
   std::ofstream(empty) << "# no geometry\n";
   EXPECT_THROW(drb::loadMeshFile(empty), drb::MeshLoadError);

@@ -13,8 +13,11 @@
 #include "diff_rigid_body/mesh_loader.h"
 #include "diff_rigid_body/scene_queries.h"
 #include "diff_rigid_body/urdf_scene.h"
+#include "../support/expect_throws.h"
+#include "../support/urdf_builders.h"
 
 namespace drb = diff_rigid_body;
+using namespace drb_test::urdf;
 
 namespace
 {
@@ -23,35 +26,12 @@ constexpr double kLengthTolerance = 1e-12;  // m
 constexpr double kFloat32LengthTolerance = 2e-8;
 const std::string kTestMeshDir = std::string(DRB_TEST_DATA_DIR) + "/meshes";
 
-std::string robot(const std::string& links)
-{
-  return "<?xml version=\"1.0\"?><robot name=\"r\"><link name=\"world\"/>" + links + "</robot>";
-}
-
-std::string joint(const std::string& type, const std::string& parent, const std::string& child,
-                  const std::string& origin = "")
-{
-  return "<joint name=\"" + child + "_joint\" type=\"" + type + "\"><parent link=\"" + parent +
-         "\"/><child link=\"" + child + "\"/>" + origin + "</joint>";
-}
-
-std::string inertial(const std::string& mass, const std::string& diagonal = "ixx=\"0.1\" iyy=\"0.1\" izz=\"0.1\"")
-{
-  return "<inertial><mass value=\"" + mass + "\"/><inertia " + diagonal +
-         " ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>";
-}
-
-std::string box(const std::string& size, const std::string& origin = "")
-{
-  return "<collision>" + origin + "<geometry><box size=\"" + size + "\"/></geometry></collision>";
-}
-
 /// Body "b" (floating) with `b_inner` in its link, and a link "tool" fixed to
 /// it at x = 1 m with `tool_inner`.
 std::string bodyWithTool(const std::string& b_inner, const std::string& tool_inner)
 {
-  return robot("<link name=\"b\">" + b_inner + "</link><link name=\"tool\">" + tool_inner + "</link>" +
-               joint("floating", "world", "b") + joint("fixed", "b", "tool", "<origin xyz=\"1 0 0\"/>"));
+  return robot(link("b", b_inner) + link("tool", tool_inner) + floatingJoint("b") +
+               joint("fixed", "b", "tool", "<origin xyz=\"1 0 0\"/>"));
 }
 
 drb::SceneOptions strict()
@@ -76,27 +56,13 @@ std::string allWarnings(const drb::Scene& scene)
     text += "\n  " + warning;
   return text.empty() ? " (none)" : text;
 }
-
-template <typename Error>
-void expectRefusal(const std::string& xml, const drb::SceneOptions& options, const std::string& fragment)
-{
-  try
-  {
-    drb::loadSceneFromUrdf(xml, options);
-    FAIL() << "loaded, expected an error containing '" << fragment << "'";
-  }
-  catch (const Error& e)
-  {
-    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
-  }
-}
 }  // namespace
 
 TEST(RealDescriptions, ZeroMassToolFrameMergesAsMassless)
 {
   // b: 2 kg at its origin; tool: 0 kg (and a zero tensor) at x = 1 m. The
   // body keeps b's mass, COM and inertia; the tool frame still gets its pose.
-  const std::string xml = bodyWithTool(inertial("2"), inertial("0", "ixx=\"0\" iyy=\"0\" izz=\"0\""));
+  const std::string xml = bodyWithTool(inertial("2"), inertial("0", diagonalInertia("0", "0", "0")));
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
   ASSERT_EQ(scene.bodies.size(), 1u);
   const drb::SceneBody& body = scene.bodies[0];
@@ -109,14 +75,16 @@ TEST(RealDescriptions, ZeroMassToolFrameMergesAsMassless)
   EXPECT_TRUE(anyWarningHas(scene, "link 'tool' <inertial>: mass must be > 0 kg, got 0; merged as massless"))
       << allWarnings(scene);
 
-  expectRefusal<drb::InvalidInertiaError>(xml, strict(), "link 'tool' <inertial>: mass must be > 0 kg, got 0");
+  DRB_EXPECT_THROWS_MESSAGE(drb::loadSceneFromUrdf(xml, strict()), drb::InvalidInertiaError,
+                            "link 'tool' <inertial>: mass must be > 0 kg, got 0");
 }
 
 TEST(RealDescriptions, LinkWithoutInertialMergesAsMasslessAndKeepsItsVertices)
 {
   // tool has a 2 x 2 x 2 box at x = 1 m and no <inertial>: 8 more vertices,
   // no mass. b's box is 1 x 1 x 1 at its origin.
-  const std::string xml = bodyWithTool(inertial("2") + box("1 1 1"), box("2 2 2"));
+  const std::string xml =
+      bodyWithTool(inertial("2") + collision(boxGeometry("1 1 1")), collision(boxGeometry("2 2 2")));
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
   const drb::SceneBody& body = scene.bodies[0];
   EXPECT_EQ(body.body.mass, 2.0);
@@ -126,15 +94,15 @@ TEST(RealDescriptions, LinkWithoutInertialMergesAsMasslessAndKeepsItsVertices)
   // tool's last corner (+1, +1, +1) in its frame is (2, 1, 1) in b's frame (the COM).
   EXPECT_TRUE(body.body.vertices.col(15).isApprox(Eigen::Vector3d(2, 1, 1), kLengthTolerance));
   EXPECT_TRUE(anyWarningHas(scene, "link 'tool': no <inertial> (set ~density")) << allWarnings(scene);
-  expectRefusal<drb::InvalidInertiaError>(xml, strict(), "link 'tool': no <inertial>");
+  DRB_EXPECT_THROWS_MESSAGE(drb::loadSceneFromUrdf(xml, strict()), drb::InvalidInertiaError,
+                            "link 'tool': no <inertial>");
 }
 
 TEST(RealDescriptions, BodyWithoutAnyMassLoadsWithAZeroMassMatrix)
 {
   // Only geometry (as urdf_tutorial's 06-flexible.urdf): the COM is the link
   // origin, M(q) = 0, and the warning points at ~density.
-  const std::string xml =
-      robot("<link name=\"b\">" + box("1 1 1") + "</link>" + joint("floating", "world", "b", "<origin xyz=\"0 0 2\"/>"));
+  const std::string xml = oneBody(collision(boxGeometry("1 1 1")), "<origin xyz=\"0 0 2\"/>");
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
   const drb::SceneBody& body = scene.bodies[0];
   EXPECT_EQ(body.body.mass, 0.0);
@@ -147,46 +115,41 @@ TEST(RealDescriptions, BodyWithoutAnyMassLoadsWithAZeroMassMatrix)
   const drb::MassMatrixAnswer answer = queries.massMatrices(queries.initialState(), { "b" }, {}, true);
   for (double entry : answer.mass_matrices)
     EXPECT_EQ(entry, 0.0);
-  expectRefusal<drb::InvalidInertiaError>(xml, strict(), "link 'b': no <inertial>");
+  DRB_EXPECT_THROWS_MESSAGE(drb::loadSceneFromUrdf(xml, strict()), drb::InvalidInertiaError, "link 'b': no <inertial>");
 }
 
 TEST(RealDescriptions, ImplausibleInertiaWarnsAndStrictRefuses)
 {
   // (1, 1, 3) breaks I1 + I2 >= I3; (0, 1, 1) has a zero principal moment.
-  const std::string triangle =
-      robot("<link name=\"b\">" + inertial("1", "ixx=\"1\" iyy=\"1\" izz=\"3\"") + "</link>" +
-            joint("floating", "world", "b"));
+  const std::string triangle = oneBody(inertial("1", diagonalInertia("1", "1", "3")));
   const drb::Scene scene = drb::loadSceneFromUrdf(triangle);
   EXPECT_EQ(scene.bodies[0].body.inertia_body(2, 2), 3.0);
   EXPECT_TRUE(anyWarningHas(scene, "link 'b' <inertial>: principal moments break the triangle inequality"))
       << allWarnings(scene);
-  expectRefusal<drb::InvalidInertiaError>(triangle, strict(), "triangle inequality");
+  DRB_EXPECT_THROWS_MESSAGE(drb::loadSceneFromUrdf(triangle, strict()), drb::InvalidInertiaError,
+                            "triangle inequality");
 
-  const std::string rod = robot("<link name=\"b\">" + inertial("1", "ixx=\"0\" iyy=\"1\" izz=\"1\"") + "</link>" +
-                                joint("floating", "world", "b"));
+  const std::string rod = oneBody(inertial("1", diagonalInertia("0", "1", "1")));
   const drb::Scene rod_scene = drb::loadSceneFromUrdf(rod);
   EXPECT_TRUE(anyWarningHas(rod_scene, "link 'b' <inertial>: inertia must be positive-definite"))
       << allWarnings(rod_scene);
   EXPECT_TRUE(anyWarningHas(rod_scene, "body 'b': a principal moment of its inertia is 0, so M(q) is singular"))
       << allWarnings(rod_scene);
-  expectRefusal<drb::InvalidInertiaError>(rod, strict(), "positive-definite");
+  DRB_EXPECT_THROWS_MESSAGE(drb::loadSceneFromUrdf(rod, strict()), drb::InvalidInertiaError, "positive-definite");
 }
 
 TEST(RealDescriptions, UndefinedInertiaIsAlwaysRefused)
 {
-  const auto body = [](const std::string& inner) {
-    return robot("<link name=\"b\">" + inner + "</link>" + joint("floating", "world", "b"));
-  };
-  expectRefusal<drb::InvalidInertiaError>(body(inertial("-1")), {}, "link 'b' <inertial>: mass must be > 0 kg, got -1");
-  expectRefusal<drb::InvalidInertiaError>(body(inertial("1", "ixx=\"-0.1\" iyy=\"1\" izz=\"1\"")), {},
-                                          "smallest principal moment is -0.1");
+  DRB_EXPECT_THROWS_MESSAGE(drb::loadSceneFromUrdf(oneBody(inertial("-1"))), drb::InvalidInertiaError,
+                            "link 'b' <inertial>: mass must be > 0 kg, got -1");
+  DRB_EXPECT_THROWS_MESSAGE(drb::loadSceneFromUrdf(oneBody(inertial("1", diagonalInertia("-0.1", "1", "1")))),
+                            drb::InvalidInertiaError, "smallest principal moment is -0.1");
 }
 
 TEST(RealDescriptions, BodyStartingAtGimbalLockWarns)
 {
   const auto floating_pitched = [](const std::string& pitch) {
-    return robot("<link name=\"b\">" + inertial("1") + "</link>" +
-                 joint("floating", "world", "b", "<origin rpy=\"0 " + pitch + " 0\"/>"));
+    return oneBody(inertial("1"), "<origin rpy=\"0 " + pitch + " 0\"/>");
   };
   const drb::Scene locked = drb::loadSceneFromUrdf(floating_pitched("1.5707963267948966"));
   EXPECT_TRUE(anyWarningHas(locked, "body 'b' (joint 'b_joint', floating) starts at gimbal lock")) << allWarnings(locked);

@@ -20,7 +20,7 @@
 #include <tf2/LinearMath/Matrix3x3.h>
 
 #include "diff_rigid_body/rpy.h"
-#include "oracles.h"
+#include "../support/oracles.h"
 
 namespace drb = diff_rigid_body;
 using namespace drb_test;
@@ -58,12 +58,8 @@ std::vector<Vector6<double>> testStates(std::uint64_t seed)
   std::vector<Vector6<double>> states;
   for (int i = 0; i < kRandomStates; ++i)
     states.push_back(rng.state());
-  for (const double theta : gimbalLockThetas())
-  {
-    Vector6<double> q = rng.state();
-    q[1] = theta;
+  for (const Vector6<double>& q : gimbalLockStates(rng))
     states.push_back(q);
-  }
   // Exact multiples of pi/2 on every axis.
   for (int a = -2; a <= 2; ++a)
     for (int b = -2; b <= 2; ++b)

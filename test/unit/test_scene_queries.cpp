@@ -10,6 +10,9 @@
 
 #include "diff_rigid_body/exceptions.h"
 #include "diff_rigid_body/scene_queries.h"
+#include "../support/expect_throws.h"
+#include "../support/kinematics_oracles.h"
+#include "../support/urdf_builders.h"
 
 namespace drb = diff_rigid_body;
 
@@ -21,46 +24,9 @@ const double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Two bodies: "cube" (8 corners of a 0.2 m box, 2 kg) and "ball" (114-vertex sphere).
 drb::SceneQueries twoBodyScene()
 {
-  const std::string xml =
-      "<robot name=\"r\"><link name=\"world\"/>"
-      "<link name=\"cube\"><inertial><mass value=\"2\"/><inertia ixx=\"0.1\" iyy=\"0.2\" izz=\"0.25\" ixy=\"0.01\" "
-      "ixz=\"0.02\" iyz=\"-0.03\"/></inertial><collision><geometry><box size=\"0.2 0.2 0.2\"/></geometry>"
-      "</collision></link>"
-      "<link name=\"ball\"><inertial><mass value=\"1\"/><inertia ixx=\"0.004\" iyy=\"0.004\" izz=\"0.004\" ixy=\"0\" "
-      "ixz=\"0\" iyz=\"0\"/></inertial><collision><geometry><sphere radius=\"0.1\"/></geometry></collision></link>"
-      "<joint name=\"jc\" type=\"floating\"><parent link=\"world\"/><child link=\"cube\"/>"
-      "<origin xyz=\"0 0 1\" rpy=\"0.1 0.2 0.3\"/></joint>"
-      "<joint name=\"jb\" type=\"floating\"><parent link=\"world\"/><child link=\"ball\"/>"
-      "<origin xyz=\"1 0 1\"/></joint></robot>";
-  return drb::SceneQueries(drb::loadSceneFromUrdf(xml));
-}
-
-// Independent reference: T^T R I_b R^T T from the elementary rotations.
-Eigen::Matrix3d angularBlockReference(const Eigen::Matrix3d& inertia, double phi, double theta, double psi)
-{
-  const Eigen::Matrix3d R = (Eigen::AngleAxisd(psi, Eigen::Vector3d::UnitZ()) *
-                             Eigen::AngleAxisd(theta, Eigen::Vector3d::UnitY()) *
-                             Eigen::AngleAxisd(phi, Eigen::Vector3d::UnitX()))
-                                .toRotationMatrix();
-  Eigen::Matrix3d T;
-  T.col(0) = R.col(0);  // X'' axis
-  T.col(1) = Eigen::AngleAxisd(psi, Eigen::Vector3d::UnitZ()) * Eigen::Vector3d::UnitY();  // Y' axis
-  T.col(2) = Eigen::Vector3d::UnitZ();
-  return T.transpose() * R * inertia * R.transpose() * T;
-}
-
-template <typename Call>
-void expectRejected(Call call, const std::string& fragment)
-{
-  try
-  {
-    call();
-    FAIL() << "accepted, expected an error containing '" << fragment << "'";
-  }
-  catch (const drb::InvalidArgumentError& e)
-  {
-    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
-  }
+  drb_test::urdf::TwoBodies scene;
+  scene.cube_rpy = "0.1 0.2 0.3";
+  return drb::SceneQueries(drb::loadSceneFromUrdf(drb_test::urdf::twoBodies(scene)));
 }
 }  // namespace
 
@@ -84,8 +50,11 @@ TEST(SceneQueries, BatchedMassMatrixLayout)
     {
       const std::size_t slot = 2 * k + i;
       const drb::RigidBody& body = queries.body(i == 0 ? 1 : 0);
+      // Independent reference: T^T R I_b R^T T from the elementary rotations.
       const Eigen::Matrix3d expected =
-          angularBlockReference(body.inertia_body, q[6 * slot], q[6 * slot + 1], q[6 * slot + 2]);
+          drb_test::refMassMatrix<double>(Eigen::Map<const drb::Vector6<double>>(q.data() + 6 * slot), body.mass,
+                                          body.inertia_body)
+              .topLeftCorner<3, 3>();
       const Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>> M(answer.mass_matrices.data() + 36 * slot);
       EXPECT_LE((M.topLeftCorner<3, 3>() - expected).norm(), kRelativeTolerance * 10 * expected.norm());
       EXPECT_EQ(M(3, 3), body.mass);
@@ -138,9 +107,12 @@ TEST(SceneQueries, SetStateIsAllOrNothingAndBitExact)
 
   drb::NamedState nan_state{ "ball", drb::Vector6<double>::Zero() };
   nan_state.q[4] = kNaN;
-  expectRejected([&] { queries.applyStates(current, { big, nan_state }); }, "states[1].q (body 'ball')[4]: not finite");
-  expectRejected([&] { queries.applyStates(current, { big, { "ghost", {} } }); }, "states[1].name: unknown body 'ghost'");
-  expectRejected([&] { queries.applyStates(current, { big, big }); }, "appears more than once");
+  DRB_EXPECT_THROWS_MESSAGE((queries.applyStates(current, { big, nan_state })), drb::InvalidArgumentError,
+                            "states[1].q (body 'ball')[4]: not finite");
+  DRB_EXPECT_THROWS_MESSAGE((queries.applyStates(current, { big, { "ghost", {} } })), drb::InvalidArgumentError,
+                            "states[1].name: unknown body 'ghost'");
+  DRB_EXPECT_THROWS_MESSAGE((queries.applyStates(current, { big, big })), drb::InvalidArgumentError,
+                            "appears more than once");
 }
 
 TEST(SceneQueries, RefusesBadRequests)
@@ -148,33 +120,35 @@ TEST(SceneQueries, RefusesBadRequests)
   const drb::SceneQueries queries = twoBodyScene();
   const drb::SceneState current = queries.initialState();
   std::vector<double> positions{ 42.0 }, jacobians{ 42.0 };
-  expectRejected([&] { queries.vertexJacobians(current, "ghost", {}, {}, positions, jacobians); },
-                 "body: unknown body 'ghost' (bodies: cube, ball)");
-  expectRejected([&] { queries.vertexJacobians(current, "cube", { 0, 8 }, {}, positions, jacobians); },
-                 "vertices[1]: index 8 out of range for body 'cube' with 8 vertices");
-  expectRejected([&] { queries.vertexJacobians(current, "cube", {}, { 0, 0, 0 }, positions, jacobians); },
-                 "q: expected 6 values");
-  expectRejected([&] { queries.vertexJacobians(current, "cube", {}, { 0, kNaN, 0, 0, 0, 0 }, positions, jacobians); },
-                 "q[1]: not finite");
+  DRB_EXPECT_THROWS_MESSAGE((queries.vertexJacobians(current, "ghost", {}, {}, positions, jacobians)),
+                            drb::InvalidArgumentError, "body: unknown body 'ghost' (bodies: cube, ball)");
+  DRB_EXPECT_THROWS_MESSAGE((queries.vertexJacobians(current, "cube", { 0, 8 }, {}, positions, jacobians)),
+                            drb::InvalidArgumentError,
+                            "vertices[1]: index 8 out of range for body 'cube' with 8 vertices");
+  DRB_EXPECT_THROWS_MESSAGE((queries.vertexJacobians(current, "cube", {}, { 0, 0, 0 }, positions, jacobians)),
+                            drb::InvalidArgumentError, "q: expected 6 values");
+  DRB_EXPECT_THROWS_MESSAGE(
+      (queries.vertexJacobians(current, "cube", {}, { 0, kNaN, 0, 0, 0, 0 }, positions, jacobians)),
+      drb::InvalidArgumentError, "q[1]: not finite");
   EXPECT_EQ(positions, std::vector<double>{ 42.0 });  // outputs untouched on refusal
-  expectRejected([&] { queries.backprop(current, "cube", { 1, 2 }, { 1, 2, 3 }, {}); },
-                 "gradients: expected 3 per vertex = 6, got 3 values");
-  expectRejected([&] { queries.backprop(current, "cube", { 1 }, { 1, kNaN, 3 }, {}); }, "gradients[1]: not finite");
-  expectRejected([&] { queries.backprop(current, "cube", {}, std::vector<double>(24, 1e308), {}); },
-                 "result gradient");
-  expectRejected([&] { queries.massMatrices(current, { "cube" }, std::vector<double>(7, 0.0), false); },
-                 "q: expected a multiple of 6 x 1 bodies");
-  expectRejected([&] { queries.massMatrices(current, { "cube", "nope" }, {}, false); },
-                 "bodies[1]: unknown body 'nope'");
-  expectRejected([&] { queries.getStates(current, { "nope" }); }, "bodies[0]: unknown body 'nope'");
+  DRB_EXPECT_THROWS_MESSAGE((queries.backprop(current, "cube", { 1, 2 }, { 1, 2, 3 }, {})), drb::InvalidArgumentError,
+                            "gradients: expected 3 per vertex = 6, got 3 values");
+  DRB_EXPECT_THROWS_MESSAGE((queries.backprop(current, "cube", { 1 }, { 1, kNaN, 3 }, {})), drb::InvalidArgumentError,
+                            "gradients[1]: not finite");
+  DRB_EXPECT_THROWS_MESSAGE((queries.backprop(current, "cube", {}, std::vector<double>(24, 1e308), {})),
+                            drb::InvalidArgumentError, "result gradient");
+  DRB_EXPECT_THROWS_MESSAGE((queries.massMatrices(current, { "cube" }, std::vector<double>(7, 0.0), false)),
+                            drb::InvalidArgumentError, "q: expected a multiple of 6 x 1 bodies");
+  DRB_EXPECT_THROWS_MESSAGE((queries.massMatrices(current, { "cube", "nope" }, {}, false)), drb::InvalidArgumentError,
+                            "bodies[1]: unknown body 'nope'");
+  DRB_EXPECT_THROWS_MESSAGE((queries.getStates(current, { "nope" })), drb::InvalidArgumentError,
+                            "bodies[0]: unknown body 'nope'");
   // Over the documented limit: refused from the sizes alone.
-  expectRejected(
-      [&] {
-        queries.massMatrices(current, { "cube" },
-                             std::vector<double>(6 * (drb::RequestLimits::kMaxMassMatricesWithDerivatives + 1), 0.0),
-                             true);
-      },
-      "at most 100000 matrices");
+  DRB_EXPECT_THROWS_MESSAGE(
+      (queries.massMatrices(current, { "cube" },
+                            std::vector<double>(6 * (drb::RequestLimits::kMaxMassMatricesWithDerivatives + 1), 0.0),
+                            true)),
+      drb::InvalidArgumentError, "at most 100000 matrices");
 }
 
 // ~get_vertex_jacobians_compact: the positions and the rotation block (the
@@ -224,12 +198,9 @@ TEST(SceneQueries, CompactTransportRefusesOverflow)
   const drb::SceneState current = queries.initialState();
   // One floating body "b": a box of `size` [m] (vertices at +-size/2).
   const auto boxBody = [](const std::string& size) {
-    return drb::SceneQueries(drb::loadSceneFromUrdf(
-        "<robot name=\"r\"><link name=\"world\"/><link name=\"b\"><inertial><mass value=\"1\"/><inertia ixx=\"1\" "
-        "iyy=\"1\" izz=\"1\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial><collision><geometry><box size=\"" +
-        size +
-        "\"/></geometry></collision></link><joint name=\"j\" type=\"floating\"><parent link=\"world\"/>"
-        "<child link=\"b\"/></joint></robot>"));
+    using namespace drb_test::urdf;
+    return drb::SceneQueries(
+        drb::loadSceneFromUrdf(oneBody(inertial("1", diagonalInertia("1", "1", "1")) + collision(boxGeometry(size)))));
   };
   std::vector<float> positions_f32{ 42.0f }, rotation_f32{ 42.0f };
   std::vector<double> positions{ 42.0 }, rotation{ 42.0 };
@@ -255,16 +226,18 @@ TEST(SceneQueries, CompactTransportRefusesOverflow)
     { giant, "b", { 0, 0, 0, 1.7e308, 0, 0 }, false, false },
   };
   for (const Overflow& o : overflows)
-    expectRejected(
-        [&] {
-          const drb::SceneState state = o.queries.initialState();
-          if (o.single_precision)
-            o.queries.vertexRotationJacobians(state, o.body, {}, o.q, o.positions_only, positions_f32, rotation_f32);
-          else
-            o.queries.vertexRotationJacobians(state, o.body, {}, o.q, o.positions_only, positions, rotation);
-        },
-        "q: position too large: vertex positions of body '" + o.body + "' would overflow" +
-            (o.single_precision ? " float32" : ""));
+  {
+    const auto request = [&] {
+      const drb::SceneState state = o.queries.initialState();
+      if (o.single_precision)
+        o.queries.vertexRotationJacobians(state, o.body, {}, o.q, o.positions_only, positions_f32, rotation_f32);
+      else
+        o.queries.vertexRotationJacobians(state, o.body, {}, o.q, o.positions_only, positions, rotation);
+    };
+    DRB_EXPECT_THROWS_MESSAGE(request(), drb::InvalidArgumentError,
+                              "q: position too large: vertex positions of body '" + o.body + "' would overflow" +
+                                  (o.single_precision ? " float32" : ""));
+  }
   // Outputs untouched on refusal.
   EXPECT_EQ(positions_f32, std::vector<float>{ 42.0f });
   EXPECT_EQ(rotation_f32, std::vector<float>{ 42.0f });

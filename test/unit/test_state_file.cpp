@@ -9,33 +9,32 @@
 #include <string>
 
 #include <sys/stat.h>
-#include <dirent.h>
 #include <unistd.h>
 
 #include <gtest/gtest.h>
 
 #include "diff_rigid_body/state_file.h"
 #include "diff_rigid_body/urdf_scene.h"
+#include "../support/expect_throws.h"
+#include "../support/state_files.h"
+#include "../support/urdf_builders.h"
 
 namespace drb = diff_rigid_body;
+using drb_test::bitwiseEqual;
+using drb_test::entriesIn;
+using drb_test::reseal;
+using drb_test::withoutTrailer;
 
 namespace
 {
 std::string twoBodyUrdf(const std::string& second_name = "ball", const std::string& cube_mass = "2")
 {
-  return "<robot name=\"r\"><link name=\"world\"/>"
-         "<link name=\"cube\"><inertial><mass value=\"" +
-         cube_mass +
-         "\"/><inertia ixx=\"0.1\" iyy=\"0.2\" izz=\"0.25\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>"
-         "<collision><geometry><box size=\"0.2 0.2 0.2\"/></geometry></collision></link>"
-         "<link name=\"" +
-         second_name +
-         "\"><inertial><mass value=\"1\"/><inertia ixx=\"0.004\" iyy=\"0.004\" izz=\"0.004\" ixy=\"0\" ixz=\"0\" "
-         "iyz=\"0\"/></inertial><collision><geometry><sphere radius=\"0.1\"/></geometry></collision></link>"
-         "<joint name=\"jc\" type=\"floating\"><parent link=\"world\"/><child link=\"cube\"/>"
-         "<origin xyz=\"0 0 1\" rpy=\"0.1 0.2 0.3\"/></joint>"
-         "<joint name=\"jb\" type=\"floating\"><parent link=\"world\"/><child link=\"" +
-         second_name + "\"/><origin xyz=\"1 0 1\"/></joint></robot>";
+  drb_test::urdf::TwoBodies scene;
+  scene.cube_mass = cube_mass;
+  scene.cube_inertia = drb_test::urdf::diagonalInertia("0.1", "0.2", "0.25");
+  scene.cube_rpy = "0.1 0.2 0.3";
+  scene.ball_name = second_name;
+  return drb_test::urdf::twoBodies(scene);
 }
 
 // A state whose values need every bit: irrational-looking, negative zero,
@@ -46,60 +45,6 @@ drb::SceneState awkwardState()
   state[0] << 0.1, -0.0, 3.141592653589793, 1e-310, -1.7976931348623157e308, 2.2250738585072014e-308;
   state[1] << -1.0 / 3.0, std::nextafter(1.0, 2.0), 1e300, -5e-324, 0.0, 123456.789;
   return state;
-}
-
-bool bitwiseEqual(const drb::SceneState& a, const drb::SceneState& b)
-{
-  return a.size() == b.size() &&
-         std::equal(a.begin(), a.end(), b.begin(), [](const drb::Vector6<double>& x, const drb::Vector6<double>& y) {
-           return std::memcmp(x.data(), y.data(), sizeof(double) * 6) == 0;
-         });
-}
-
-// Expects parseStateFile to refuse `text` with `fragment` in the message.
-void expectRefused(const std::string& text, const drb::Scene& scene, const std::string& fragment)
-{
-  try
-  {
-    drb::parseStateFile(text, scene);
-    FAIL() << "accepted, expected an error containing '" << fragment << "'";
-  }
-  catch (const drb::StateFileError& e)
-  {
-    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
-  }
-}
-
-// Re-seals an edited body of a file with a correct trailer, so that the
-// checks behind the checksum are reached.
-std::string reseal(const std::string& body, std::size_t count)
-{
-  char crc[16];
-  std::snprintf(crc, sizeof crc, "%08x", drb::crc32(body));
-  return body + "end " + std::to_string(count) + " crc32 " + crc + "\n";
-}
-
-std::string withoutTrailer(const std::string& text)
-{
-  return text.substr(0, text.rfind("end "));
-}
-
-std::string tempFolder()
-{
-  std::string folder = ::testing::TempDir() + "drb_state_file_XXXXXX";
-  if (!::mkdtemp(folder.data()))
-    throw std::runtime_error("mkdtemp failed");
-  return folder;
-}
-
-std::size_t entriesIn(const std::string& folder)
-{
-  std::size_t n = 0;
-  DIR* dir = ::opendir(folder.c_str());
-  while (dirent* entry = ::readdir(dir))
-    n += std::string(entry->d_name) != "." && std::string(entry->d_name) != "..";
-  ::closedir(dir);
-  return n;
 }
 }  // namespace
 
@@ -151,44 +96,60 @@ TEST(StateFile, RefusesDamagedFiles)
 {
   const drb::Scene scene = drb::loadSceneFromUrdf(twoBodyUrdf());
   const std::string good = drb::formatStateFile(scene, awkwardState());
-  expectRefused("", scene, "empty file");
-  expectRefused(good.substr(0, good.size() - 1), scene, "truncated: the last line has no line end");
-  expectRefused(good.substr(0, good.find("body ball")), scene, "truncated: no 'end' line");
-  expectRefused(good + "body extra 0x0p+0\n", scene, "truncated: no 'end' line");
-  expectRefused("not a state file\n", scene, "line 1: expected 'diff_rigid_body state file v1'");
-  expectRefused("diff_rigid_body state file v2\n" + good.substr(good.find('\n') + 1), scene, "line 1: expected");
+  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile("", scene), drb::StateFileError, "empty file");
+  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(good.substr(0, good.size() - 1), scene), drb::StateFileError,
+                            "truncated: the last line has no line end");
+  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(good.substr(0, good.find("body ball")), scene), drb::StateFileError,
+                            "truncated: no 'end' line");
+  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(good + "body extra 0x0p+0\n", scene), drb::StateFileError,
+                            "truncated: no 'end' line");
+  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile("not a state file\n", scene), drb::StateFileError,
+                            "line 1: expected 'diff_rigid_body state file v1'");
+  DRB_EXPECT_THROWS_MESSAGE(
+      drb::parseStateFile("diff_rigid_body state file v2\n" + good.substr(good.find('\n') + 1), scene),
+      drb::StateFileError, "line 1: expected");
   // One flipped bit anywhere before the trailer.
   std::string flipped = good;
   flipped[good.find("body cube") + 12] ^= 0x01;
-  expectRefused(flipped, scene, "checksum mismatch: the file is corrupt");
+  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(flipped, scene), drb::StateFileError,
+                            "checksum mismatch: the file is corrupt");
   std::string bad_end = good;
   bad_end.replace(bad_end.rfind("crc32"), 5, "crc33");
-  expectRefused(bad_end, scene, "expected 'end <count> crc32 <8 hex digits>'");
+  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(bad_end, scene), drb::StateFileError,
+                            "expected 'end <count> crc32 <8 hex digits>'");
   // Correct checksums over wrong contents.
   std::string body = withoutTrailer(good);
-  expectRefused(reseal(body, 3), scene, "body count mismatch");
+  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(reseal(body, 3), scene), drb::StateFileError, "body count mismatch");
   std::string count = body;
   count.replace(count.find("bodies 2"), 8, "bodies 3");
-  expectRefused(reseal(count, 3), scene, "body count mismatch: 'bodies 3', 2 body lines");
+  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(reseal(count, 3), scene), drb::StateFileError,
+                            "body count mismatch: 'bodies 3', 2 body lines");
   std::string nan_line = body.substr(0, body.find("body cube")) + "body cube nan 0x0p+0 0x0p+0 0x0p+0 0x0p+0 0x0p+0\n" +
                          body.substr(body.find("body ball"));
-  expectRefused(reseal(nan_line, 2), scene, "q[0] of body 'cube': not a hex float: 'nan'");
+  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(reseal(nan_line, 2), scene), drb::StateFileError,
+                            "q[0] of body 'cube': not a hex float: 'nan'");
   std::string inf_line = body.substr(0, body.find("body cube")) +
                          "body cube 0x0p+0 0xinf 0x0p+0 0x0p+0 0x0p+0 0x0p+0\n" + body.substr(body.find("body ball"));
-  expectRefused(reseal(inf_line, 2), scene, "q[1] of body 'cube': not finite");
+  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(reseal(inf_line, 2), scene), drb::StateFileError,
+                            "q[1] of body 'cube': not finite");
   std::string decimal = body.substr(0, body.find("body cube")) + "body cube 0.5 0x0p+0 0x0p+0 0x0p+0 0x0p+0 0x0p+0\n" +
                         body.substr(body.find("body ball"));
-  expectRefused(reseal(decimal, 2), scene, "q[0] of body 'cube': not a hex float: '0.5'");
+  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(reseal(decimal, 2), scene), drb::StateFileError,
+                            "q[0] of body 'cube': not a hex float: '0.5'");
   std::string short_line = body.substr(0, body.find("body cube")) + "body cube 0x0p+0 0x0p+0\n" +
                            body.substr(body.find("body ball"));
-  expectRefused(reseal(short_line, 2), scene, "line 4: expected 'body <name> <6 hex floats>'");
+  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(reseal(short_line, 2), scene), drb::StateFileError,
+                            "line 4: expected 'body <name> <6 hex floats>'");
   std::string bad_name = body.substr(0, body.find("body cube")) +
                          "body cu%4 0x0p+0 0x0p+0 0x0p+0 0x0p+0 0x0p+0 0x0p+0\n" + body.substr(body.find("body ball"));
-  expectRefused(reseal(bad_name, 2), scene, "line 4: malformed body name 'cu%4'");
+  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(reseal(bad_name, 2), scene), drb::StateFileError,
+                            "line 4: malformed body name 'cu%4'");
   std::string crlf = body;
   crlf.replace(crlf.find("bodies 2\n"), 9, "bodies 2\r\n");
-  expectRefused(reseal(crlf, 2), scene, "line 3: expected 'bodies <count>'");
-  expectRefused(std::string(drb::maxStateFileSize(2) + 1, '\n'), scene, "too large");
+  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(reseal(crlf, 2), scene), drb::StateFileError,
+                            "line 3: expected 'bodies <count>'");
+  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(std::string(drb::maxStateFileSize(2) + 1, '\n'), scene),
+                            drb::StateFileError, "too large");
 }
 
 TEST(StateFile, RefusesFilesOfAnotherScene)
@@ -196,14 +157,16 @@ TEST(StateFile, RefusesFilesOfAnotherScene)
   const drb::Scene scene = drb::loadSceneFromUrdf(twoBodyUrdf());
   const drb::SceneState state = awkwardState();
   const drb::Scene renamed = drb::loadSceneFromUrdf(twoBodyUrdf("sphere"));
-  expectRefused(drb::formatStateFile(renamed, state), scene,
-                "saved for other bodies: the file has [cube, sphere], the scene has [cube, ball]");
+  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(drb::formatStateFile(renamed, state), scene), drb::StateFileError,
+                            "saved for other bodies: the file has [cube, sphere], the scene has [cube, ball]");
   const drb::Scene heavier = drb::loadSceneFromUrdf(twoBodyUrdf("ball", "2.5"));
-  expectRefused(drb::formatStateFile(heavier, state), scene, "saved for another scene: fingerprint");
+  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(drb::formatStateFile(heavier, state), scene), drb::StateFileError,
+                            "saved for another scene: fingerprint");
   drb::SceneOptions one_body;
   one_body.bodies = { "cube" };
   const drb::Scene subset = drb::loadSceneFromUrdf(twoBodyUrdf(), one_body);
-  expectRefused(drb::formatStateFile(subset, { state[0] }), scene, "the file has [cube], the scene has [cube, ball]");
+  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(drb::formatStateFile(subset, { state[0] }), scene), drb::StateFileError,
+                            "the file has [cube], the scene has [cube, ball]");
   EXPECT_NE(drb::sceneFingerprint(scene), drb::sceneFingerprint(heavier));
   EXPECT_EQ(drb::sceneFingerprint(scene), drb::sceneFingerprint(drb::loadSceneFromUrdf(twoBodyUrdf())));
 }
@@ -220,7 +183,7 @@ TEST(StateFile, RefusesToSaveInvalidStates)
 TEST(StateFile, DurableWriteAndRead)
 {
   const drb::Scene scene = drb::loadSceneFromUrdf(twoBodyUrdf());
-  const std::string folder = tempFolder();
+  const std::string folder = drb_test::tempFolder("drb_state_file");
   const std::string path = folder + "/state";
   EXPECT_FALSE(drb::readStateFile(path, scene).has_value());  // no file yet: not an error
   drb::SceneState state = awkwardState();
@@ -233,32 +196,15 @@ TEST(StateFile, DurableWriteAndRead)
 
   // A damaged file names its path, and can be set aside for inspection.
   std::ofstream(path, std::ios::app) << "junk\n";
-  try
-  {
-    drb::readStateFile(path, scene);
-    FAIL();
-  }
-  catch (const drb::StateFileError& e)
-  {
-    EXPECT_NE(std::string(e.what()).find("state file '" + path + "': truncated"), std::string::npos) << e.what();
-  }
+  DRB_EXPECT_THROWS_MESSAGE(drb::readStateFile(path, scene), drb::StateFileError,
+                            "state file '" + path + "': truncated");
   EXPECT_EQ(drb::setStateFileAside(path), path + ".bad");
   EXPECT_FALSE(drb::readStateFile(path, scene).has_value());
   std::remove((path + ".bad").c_str());
 
   // Unwritable places fail with the system's reason, and leave nothing behind.
-  try
-  {
-    drb::writeStateFile(folder + "/missing/state", scene, state);
-    FAIL();
-  }
-  catch (const drb::StateFileError& e)
-  {
-    EXPECT_NE(std::string(e.what()).find("cannot create a temporary file in '" + folder + "/missing'"),
-              std::string::npos)
-        << e.what();
-    EXPECT_NE(std::string(e.what()).find("No such file or directory"), std::string::npos) << e.what();
-  }
+  DRB_EXPECT_THROWS_MESSAGE(drb::writeStateFile(folder + "/missing/state", scene, state), drb::StateFileError,
+                            "cannot create a temporary file in '" + folder + "/missing'", "No such file or directory");
   ::mkdir(path.c_str(), 0700);  // a folder where the file should be
   EXPECT_THROW(drb::writeStateFile(path, scene, state), drb::StateFileError);
   EXPECT_THROW(drb::readStateFile(path, scene), drb::StateFileError);
@@ -276,15 +222,7 @@ TEST(StateFile, DurableWriteAndRead)
 
   // Oversized files are refused from their size, before they are read.
   std::ofstream(path) << std::string(drb::maxStateFileSize(2) + 1, 'x');
-  try
-  {
-    drb::readStateFile(path, scene);
-    FAIL();
-  }
-  catch (const drb::StateFileError& e)
-  {
-    EXPECT_NE(std::string(e.what()).find("too large"), std::string::npos) << e.what();
-  }
+  DRB_EXPECT_THROWS_MESSAGE(drb::readStateFile(path, scene), drb::StateFileError, "too large");
   std::remove(path.c_str());
   ::rmdir(folder.c_str());
 }

@@ -8,8 +8,11 @@
 
 #include "diff_rigid_body/exceptions.h"
 #include "diff_rigid_body/urdf_scene.h"
+#include "../support/expect_throws.h"
+#include "../support/urdf_builders.h"
 
 namespace drb = diff_rigid_body;
+using namespace drb_test::urdf;
 
 namespace
 {
@@ -17,37 +20,6 @@ constexpr double kLengthTolerance = 1e-12;   // m
 constexpr double kInertiaTolerance = 1e-12;  // kg m^2
 constexpr double kAngleTolerance = 1e-12;    // rad
 const std::string kTestMeshDir = std::string(DRB_TEST_DATA_DIR) + "/meshes";
-
-std::string robot(const std::string& body)
-{
-  return "<?xml version=\"1.0\"?><robot name=\"r\"><link name=\"world\"/>" + body + "</robot>";
-}
-
-std::string floatingJoint(const std::string& child, const std::string& origin = "")
-{
-  return "<joint name=\"" + child + "_joint\" type=\"floating\"><parent link=\"world\"/><child link=\"" + child +
-         "\"/>" + origin + "</joint>";
-}
-
-std::string unitInertial(const std::string& mass = "1")
-{
-  return "<inertial><mass value=\"" + mass +
-         "\"/><inertia ixx=\"0.1\" iyy=\"0.1\" izz=\"0.1\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>";
-}
-
-template <typename Error>
-void expectLoadError(const std::string& xml, const std::string& fragment, const drb::SceneOptions& options = {})
-{
-  try
-  {
-    drb::loadSceneFromUrdf(xml, options);
-    FAIL() << "loaded, expected an error containing '" << fragment << "'";
-  }
-  catch (const Error& e)
-  {
-    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
-  }
-}
 }  // namespace
 
 TEST(UrdfScene, ComOffsetAndRotatedInertialFrame)
@@ -83,13 +55,13 @@ TEST(UrdfScene, MergesFixedLinksTransitivelyWithParallelAxisInertia)
   // base (1 kg at its origin) + arm (1 kg, 1 m along x) + massless tip:
   //   mass 2 kg, COM (0.5, 0, 0);
   //   I = 2 * diag(0.1) + 2 * 1 kg * diag(0, 0.25, 0.25) = diag(0.2, 0.7, 0.7).
-  const std::string xml = robot(
-      "<link name=\"base\">" + unitInertial() + "</link><link name=\"arm\">" + unitInertial() +
-      "</link><link name=\"tip\"/>" + floatingJoint("base", "<origin xyz=\"0 0 1\" rpy=\"0 0 0.5\"/>") +
-      "<joint name=\"j_arm\" type=\"fixed\"><parent link=\"base\"/><child link=\"arm\"/>"
-      "<origin xyz=\"1 0 0\"/></joint>"
-      "<joint name=\"j_tip\" type=\"fixed\"><parent link=\"arm\"/><child link=\"tip\"/>"
-      "<origin xyz=\"0 1 0\" rpy=\"0.3 0 0\"/></joint>");
+  const std::string xml =
+      robot("<link name=\"base\">" + inertial() + "</link><link name=\"arm\">" + inertial() +
+            "</link><link name=\"tip\"/>" + floatingJoint("base", "<origin xyz=\"0 0 1\" rpy=\"0 0 0.5\"/>") +
+            "<joint name=\"j_arm\" type=\"fixed\"><parent link=\"base\"/><child link=\"arm\"/>"
+            "<origin xyz=\"1 0 0\"/></joint>"
+            "<joint name=\"j_tip\" type=\"fixed\"><parent link=\"arm\"/><child link=\"tip\"/>"
+            "<origin xyz=\"0 1 0\" rpy=\"0.3 0 0\"/></joint>");
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
   ASSERT_EQ(scene.bodies.size(), 1u);
   const drb::SceneBody& body = scene.bodies[0];
@@ -112,18 +84,19 @@ TEST(UrdfScene, MergesFixedLinksTransitivelyWithParallelAxisInertia)
 
 TEST(UrdfScene, StaticLinksAndUnmodelledJoints)
 {
-  const std::string xml = robot(
-      "<link name=\"table\"><collision><geometry><box size=\"1 1 1\"/></geometry></collision></link>"
-      "<link name=\"box\">" +
-      unitInertial() + "</link><link name=\"flap\">" + unitInertial() +
-      "</link>"
-      "<joint name=\"j_table\" type=\"fixed\"><parent link=\"world\"/><child link=\"table\"/>"
-      "<origin xyz=\"0 0 0.5\"/></joint>" +
-      "<joint name=\"j_box\" type=\"floating\"><parent link=\"table\"/><child link=\"box\"/>"
-      "<origin xyz=\"0 0 1\"/></joint>"
-      "<joint name=\"hinge\" type=\"revolute\"><parent link=\"box\"/><child link=\"flap\"/>"
-      "<origin xyz=\"0 0 0.25\"/><axis xyz=\"1 0 0\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" "
-      "velocity=\"1\"/></joint>");
+  const std::string xml = robot("<link name=\"table\"><collision><geometry><box size=\"1 1 "
+                                "1\"/></geometry></collision></link>"
+                                "<link name=\"box\">" +
+                                inertial() + "</link><link name=\"flap\">" + inertial() +
+                                "</link>"
+                                "<joint name=\"j_table\" type=\"fixed\"><parent link=\"world\"/><child link=\"table\"/>"
+                                "<origin xyz=\"0 0 0.5\"/></joint>" +
+                                "<joint name=\"j_box\" type=\"floating\"><parent link=\"table\"/><child link=\"box\"/>"
+                                "<origin xyz=\"0 0 1\"/></joint>"
+                                "<joint name=\"hinge\" type=\"revolute\"><parent link=\"box\"/><child link=\"flap\"/>"
+                                "<origin xyz=\"0 0 0.25\"/><axis xyz=\"1 0 0\"/><limit lower=\"-1\" upper=\"1\" "
+                                "effort=\"1\" "
+                                "velocity=\"1\"/></joint>");
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
   ASSERT_EQ(scene.static_links.size(), 1u);
   EXPECT_EQ(scene.static_links[0].name, "table");
@@ -160,10 +133,18 @@ TEST(UrdfScene, MeshScaleAndOriginFromAFile)
   // -> (0,0,0), (0,2,0), (-3,0,0), (0,0,4); then + (0.5, 0, 0). Mesh order is
   // the order of first use by the faces (first face: 1 3 2).
   const std::string xml = robot(
-      "<link name=\"tet\"><inertial><mass value=\"1\"/><inertia ixx=\"0.1\" iyy=\"0.1\" izz=\"0.1\" ixy=\"0\" "
-      "ixz=\"0\" iyz=\"0\"/></inertial><collision><origin xyz=\"0.5 0 0\" rpy=\"0 0 1.5707963267948966\"/>"
-      "<geometry><mesh filename=\"file://" +
-      kTestMeshDir + "/tetrahedron.obj\" scale=\"2 3 4\"/></geometry></collision></link>" + floatingJoint("tet"));
+      link("tet", inertial() + collision(meshGeometry("file://" + kTestMeshDir + "/tetrahedron.obj", "2 3 4"), "<origin"
+                                                                                                               " xyz="
+                                                                                                               "\"0.5 "
+                                                                                                               "0 0\" "
+                                                                                                               "rpy="
+                                                                                                               "\"0 0 "
+                                                                                                               "1."
+                                                                                                               "5707963"
+                                                                                                               "2679489"
+                                                                                                               "66\"/"
+                                                                                                               ">")) +
+      floatingJoint("tet"));
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
   const Eigen::Matrix3Xd& v = scene.bodies[0].body.vertices;
   ASSERT_EQ(v.cols(), 4);
@@ -175,11 +156,11 @@ TEST(UrdfScene, MeshScaleAndOriginFromAFile)
 
 TEST(UrdfScene, PackageUrisAndVisualGeometry)
 {
-  const std::string xml = robot(
-      "<link name=\"b\">" + unitInertial() +
-      "<visual><geometry><mesh filename=\"package://test_pkg/meshes/box_2x1x0.5.stl\"/></geometry></visual>"
-      "<collision><geometry><sphere radius=\"1\"/></geometry></collision></link>" +
-      floatingJoint("b"));
+  const std::string xml = robot("<link name=\"b\">" + inertial() +
+                                "<visual><geometry><mesh "
+                                "filename=\"package://test_pkg/meshes/box_2x1x0.5.stl\"/></geometry></visual>"
+                                "<collision><geometry><sphere radius=\"1\"/></geometry></collision></link>" +
+                                floatingJoint("b"));
   drb::SceneOptions options;
   options.find_package = [](const std::string& package) {
     return package == "test_pkg" ? std::string(DRB_TEST_DATA_DIR) : std::string();
@@ -192,7 +173,8 @@ TEST(UrdfScene, PackageUrisAndVisualGeometry)
 
   drb::SceneOptions no_resolver;
   no_resolver.geometry = drb::GeometrySource::Visual;
-  expectLoadError<drb::MeshLoadError>(xml, "cannot find package 'test_pkg'", no_resolver);
+  DRB_EXPECT_THROWS_MESSAGE(drb::loadSceneFromUrdf(xml, no_resolver), drb::MeshLoadError,
+                            "cannot find package 'test_pkg'");
 }
 
 TEST(UrdfScene, InertiaFromDensity)
@@ -213,25 +195,23 @@ TEST(UrdfScene, InertiaFromDensity)
 
 TEST(UrdfScene, RejectsUnusableDescriptions)
 {
-  const std::string ok_body = "<link name=\"b\">" + unitInertial() + "</link>" + floatingJoint("b");
-  expectLoadError<drb::SceneDescriptionError>("<robot name=\"r\"><link name=\"world\"></robot>", "malformed XML");
-  expectLoadError<drb::SceneDescriptionError>(robot(""), "no body");
-  expectLoadError<drb::InvalidInertiaError>(robot("<link name=\"b\">" + unitInertial("-1") + "</link>" +
-                                                  floatingJoint("b")),
-                                            "link 'b' <inertial>: mass must be > 0");
-  expectLoadError<drb::MeshLoadError>(
-      robot("<link name=\"b\">" + unitInertial() +
-            "<collision><geometry><mesh filename=\"/nonexistent/missing.stl\"/></geometry></collision></link>" +
-            floatingJoint("b")),
-      "/nonexistent/missing.stl");
-  expectLoadError<drb::SceneDescriptionError>(
-      robot("<link name=\"b\">" + unitInertial() +
-            "<collision><geometry><box size=\"1 0 1\"/></geometry></collision></link>" + floatingJoint("b")),
-      "box size y must be finite and > 0");
+  const std::string ok_body = link("b", inertial()) + floatingJoint("b");
+  DRB_EXPECT_THROWS_MESSAGE(drb::loadSceneFromUrdf("<robot name=\"r\"><link name=\"world\"></robot>"),
+                            drb::SceneDescriptionError, "malformed XML");
+  DRB_EXPECT_THROWS_MESSAGE(drb::loadSceneFromUrdf(robot("")), drb::SceneDescriptionError, "no body");
+  DRB_EXPECT_THROWS_MESSAGE(drb::loadSceneFromUrdf(oneBody(inertial("-1"))), drb::InvalidInertiaError,
+                            "link 'b' <inertial>: mass must be > 0");
+  DRB_EXPECT_THROWS_MESSAGE(drb::loadSceneFromUrdf(oneBody(inertial() + collision(meshGeometry("/nonexistent/"
+                                                                                               "missing.stl")))),
+                            drb::MeshLoadError, "/nonexistent/missing.stl");
+  DRB_EXPECT_THROWS_MESSAGE(drb::loadSceneFromUrdf(oneBody(inertial() + collision(boxGeometry("1 0 1")))),
+                            drb::SceneDescriptionError, "box size y must be finite and > 0");
   drb::SceneOptions unknown;
   unknown.bodies = { "nope" };
-  expectLoadError<drb::SceneDescriptionError>(robot(ok_body), "unknown body 'nope'", unknown);
+  DRB_EXPECT_THROWS_MESSAGE(drb::loadSceneFromUrdf(robot(ok_body), unknown), drb::SceneDescriptionError,
+                            "unknown body 'nope'");
   drb::SceneOptions bad_frame;
   bad_frame.fixed_frame = "b";
-  expectLoadError<drb::SceneDescriptionError>(robot(ok_body), "fixed_frame: 'b'", bad_frame);
+  DRB_EXPECT_THROWS_MESSAGE(drb::loadSceneFromUrdf(robot(ok_body), bad_frame), drb::SceneDescriptionError,
+                            "fixed_frame: 'b'");
 }

@@ -28,7 +28,7 @@
 
 #include "diff_rigid_body/vertex_columns.h"
 #include "diff_rigid_body/vertex_jacobian.h"
-#include "oracles.h"
+#include "../support/oracles.h"
 
 namespace drb = diff_rigid_body;
 using namespace drb_test;
@@ -594,13 +594,7 @@ TEST(Backprop, HardCases)
 {
   Random rng(303);
   MaxTracker err;
-  std::vector<Vector6<double>> states;
-  for (const double theta : gimbalLockThetas())
-  {
-    Vector6<double> q = rng.state();
-    q[1] = theta;
-    states.push_back(q);
-  }
+  std::vector<Vector6<double>> states = gimbalLockStates(rng);
   for (const double a : largeAngles())
   {
     Vector6<double> q = rng.state();

@@ -1,16 +1,9 @@
-// Shared test oracles for the kinematics kernels (rpy.h, mass_matrix.h,
-// vertex_jacobian.h).
-//
-// Everything here is written from docs/derivation.md, NOT from the
-// headers under test: rotations are products of elementary rotations, dR is
-// the long form (Rz Ry Rx' etc.), T is assembled from the definition of the
-// rotation axes, M is T^T R I_b R^T T. The kernels use the closed-form entries,
-// cross products, A = R^T T and A^T I_b A instead, so an agreement between the
-// two is evidence, not a tautology.
-//
-// Also here: fixed-seed random states, the hard-case list of
-// docs/derivation.md ("Hard cases"), a
-// complex-step helper and error metrics (max-abs, ulp).
+// Test oracles of the kernels (rpy.h, mass_matrix.h, vertex_jacobian.h)
+// beyond the kinematics of kinematics_oracles.h (included): fixed-seed
+// random states, bodies and inertias, the hard-case list of
+// docs/derivation.md ("Hard cases"), exact angle reduction (MPFR), a
+// complex-step helper and error metrics (max-abs, ulp). Needs MPFR (mpreal.h),
+// so only test_core includes it.
 #pragma once
 
 #include <algorithm>
@@ -26,199 +19,15 @@
 #include <Eigen/Core>
 #include <mpreal.h>
 
-#include "diff_rigid_body/rpy.h"
+#include "kinematics_oracles.h"
 
 namespace drb_test
 {
-using diff_rigid_body::Matrix3;
-using diff_rigid_body::Matrix36;
-using diff_rigid_body::Matrix6;
-using diff_rigid_body::Vector3;
-using diff_rigid_body::Vector6;
 using Complex = std::complex<double>;
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();  // 2^-52
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kHalfPi = kPi / 2;  // == M_PI_2, the double nearest pi/2
-
-// ---------------------------------------------------------------------------
-// Elementary rotations and their derivatives (right-handed, active).
-
-template <typename S>
-Matrix3<S> rotX(const S& a)
-{
-  using std::cos;
-  using std::sin;
-  const S c = cos(a), s = sin(a);
-  Matrix3<S> m;
-  m << S(1), S(0), S(0),  //
-      S(0), c, -s,        //
-      S(0), s, c;
-  return m;
-}
-
-template <typename S>
-Matrix3<S> rotY(const S& a)
-{
-  using std::cos;
-  using std::sin;
-  const S c = cos(a), s = sin(a);
-  Matrix3<S> m;
-  m << c, S(0), s,     //
-      S(0), S(1), S(0),  //
-      -s, S(0), c;
-  return m;
-}
-
-template <typename S>
-Matrix3<S> rotZ(const S& a)
-{
-  using std::cos;
-  using std::sin;
-  const S c = cos(a), s = sin(a);
-  Matrix3<S> m;
-  m << c, -s, S(0),  //
-      s, c, S(0),    //
-      S(0), S(0), S(1);
-  return m;
-}
-
-// d/da of the elementary rotations (entry-wise derivative).
-template <typename S>
-Matrix3<S> rotXPrime(const S& a)
-{
-  using std::cos;
-  using std::sin;
-  const S c = cos(a), s = sin(a);
-  Matrix3<S> m;
-  m << S(0), S(0), S(0),  //
-      S(0), -s, -c,       //
-      S(0), c, -s;
-  return m;
-}
-
-template <typename S>
-Matrix3<S> rotYPrime(const S& a)
-{
-  using std::cos;
-  using std::sin;
-  const S c = cos(a), s = sin(a);
-  Matrix3<S> m;
-  m << -s, S(0), c,        //
-      S(0), S(0), S(0),  //
-      -c, S(0), -s;
-  return m;
-}
-
-template <typename S>
-Matrix3<S> rotZPrime(const S& a)
-{
-  using std::cos;
-  using std::sin;
-  const S c = cos(a), s = sin(a);
-  Matrix3<S> m;
-  m << -s, -c, S(0),  //
-      c, -s, S(0),    //
-      S(0), S(0), S(0);
-  return m;
-}
-
-// ---------------------------------------------------------------------------
-// Reference kinematics (docs/derivation.md, "Coordinates and frames",
-// "Angular velocity"), q = (phi, theta, psi, tx, ty, tz).
-
-/// R = Rz(psi) Ry(theta) Rx(phi), as a product of elementary rotations.
-template <typename S>
-Matrix3<S> refRotation(const S& phi, const S& theta, const S& psi)
-{
-  return rotZ(psi) * rotY(theta) * rotX(phi);
-}
-
-/// Long form: dR/dphi = Rz Ry Rx', dR/dtheta = Rz Ry' Rx, dR/dpsi = Rz' Ry Rx.
-template <typename S>
-std::array<Matrix3<S>, 3> refRotationDerivatives(const S& phi, const S& theta, const S& psi)
-{
-  return { rotZ(psi) * rotY(theta) * rotXPrime(phi), rotZ(psi) * rotYPrime(theta) * rotX(phi),
-           rotZPrime(psi) * rotY(theta) * rotX(phi) };
-}
-
-/// T from the axis definition: omega = phidot e_X'' + thetadot e_Y' + psidot e_Z.
-/// In world coordinates e_Z = (0,0,1), e_Y' = Rz(psi) e_y and
-/// e_X'' = Rz(psi) Ry(theta) e_x (Rx(phi) leaves e_x fixed).
-template <typename S>
-Matrix3<S> refAngularVelocityMatrix(const S& phi, const S& theta, const S& psi)
-{
-  (void)phi;
-  const Vector3<S> ex(S(1), S(0), S(0)), ey(S(0), S(1), S(0)), ez(S(0), S(0), S(1));
-  Matrix3<S> T;
-  T.col(0) = rotZ(psi) * (rotY(theta) * ex);
-  T.col(1) = rotZ(psi) * ey;
-  T.col(2) = ez;
-  return T;
-}
-
-/// [v]_x, the cross-product matrix.
-template <typename S>
-Matrix3<S> skew(const Vector3<S>& v)
-{
-  Matrix3<S> m;
-  m << S(0), -v[2], v[1],  //
-      v[2], S(0), -v[0],   //
-      -v[1], v[0], S(0);
-  return m;
-}
-
-/// Inverse of skew, taking the antisymmetric part.
-template <typename S>
-Vector3<S> vee(const Matrix3<S>& m)
-{
-  return Vector3<S>((m(2, 1) - m(1, 2)) / S(2), (m(0, 2) - m(2, 0)) / S(2), (m(1, 0) - m(0, 1)) / S(2));
-}
-
-/// J = [dR/dphi p0, dR/dtheta p0, dR/dpsi p0 | I3], long form.
-template <typename S>
-Matrix36<S> refJacobian(const Vector6<S>& q, const Vector3<S>& p0)
-{
-  const auto dR = refRotationDerivatives(q[0], q[1], q[2]);
-  Matrix36<S> J = Matrix36<S>::Zero();
-  for (int k = 0; k < 3; ++k)
-    J.col(k) = dR[k] * p0;
-  J.template rightCols<3>().setIdentity();
-  return J;
-}
-
-/// p = R p0 + t with the product-form R.
-template <typename S>
-Vector3<S> refPosition(const Vector6<S>& q, const Vector3<S>& p0)
-{
-  return refRotation(q[0], q[1], q[2]) * p0 + q.template tail<3>();
-}
-
-/// M = blockdiag(T^T I' T, m I3), I' = R I_b R^T: the world-frame form
-/// (docs/derivation.md, "Mass matrix"; the seed's eq. (22) prints I3 for m I3).
-template <typename S>
-Matrix6<S> refMassMatrix(const Vector6<S>& q, const S& mass, const Matrix3<S>& inertia_body)
-{
-  const Matrix3<S> R = refRotation(q[0], q[1], q[2]);
-  const Matrix3<S> T = refAngularVelocityMatrix(q[0], q[1], q[2]);
-  const Matrix3<S> I_world = R * inertia_body * R.transpose();
-  Matrix6<S> M = Matrix6<S>::Zero();
-  M.template topLeftCorner<3, 3>() = T.transpose() * I_world * T;
-  for (int i = 3; i < 6; ++i)
-    M(i, i) = mass;
-  return M;
-}
-
-/// Inertia about the origin of point masses (docs/derivation.md, "Inertia", particles):
-/// I = sum m_i (p_i^T p_i I3 - p_i p_i^T).
-template <typename S>
-Matrix3<S> particleInertia(const std::vector<Vector3<S>>& points, const std::vector<S>& masses)
-{
-  Matrix3<S> I = Matrix3<S>::Zero();
-  for (std::size_t i = 0; i < points.size(); ++i)
-    I += masses[i] * (points[i].squaredNorm() * Matrix3<S>::Identity() - points[i] * points[i].transpose());
-  return I;
-}
 
 // ---------------------------------------------------------------------------
 // Complex step.
@@ -346,6 +155,20 @@ inline std::vector<double> gimbalLockThetas()
     }
   }
   return thetas;
+}
+
+/// One rng.state() per gimbalLockThetas() entry, in that order, with theta
+/// set to it.
+inline std::vector<Vector6<double>> gimbalLockStates(Random& rng)
+{
+  std::vector<Vector6<double>> states;
+  for (const double theta : gimbalLockThetas())
+  {
+    Vector6<double> q = rng.state();
+    q[1] = theta;
+    states.push_back(q);
+  }
+  return states;
 }
 
 /// The subset of gimbalLockThetas() at which cos^2(theta) is below double
