@@ -14,6 +14,7 @@
 
 #include "bench_common.h"
 #include "diff_rigid_body/mass_properties.h"
+#include "reference/particle_mass_properties.h"
 
 namespace
 {

@@ -167,13 +167,4 @@ std::array<Matrix6<Scalar>, 6> massMatrixDerivatives(const Eigen::MatrixBase<Der
   return massMatrixDerivatives(RpyTrig<Scalar>(q[PHI], q[THETA], Scalar(0)), inertia_body);
 }
 
-/// cos(theta): the gimbal-lock diagnostic. 1 far from the singularity, 0 at
-/// theta = +-pi/2, where the angular block of M loses rank.
-template <typename Scalar>
-Scalar gimbalLockCosine(const Scalar& theta)
-{
-  using std::cos;
-  return cos(theta);
-}
-
 }  // namespace diff_rigid_body

@@ -1,7 +1,9 @@
-// Mass properties: composites by the parallel-axis theorem, closed-form
-// primitives, the exact polyhedral integral of a closed mesh, and the seed
-// paper's particle sum (eq. 17) over grid samples inside a mesh. Formulas:
-// docs/derivation.md, "Inertia".
+// Mass properties: composites by the parallel-axis theorem
+// (src/core/composite_mass_properties.cpp), closed-form primitives
+// (primitive_mass_properties.cpp) and the exact polyhedral integral of a
+// closed mesh (mesh_mass_properties.cpp). Formulas: docs/derivation.md,
+// "Inertia". The seed paper's particle sum (eq. 17), a reference for tests
+// and benchmarks, is in bench/reference/particle_mass_properties.h.
 //
 // Conventions (all functions):
 //   MassProperties.mass     [kg]
@@ -116,58 +118,5 @@ MeshVolumeIntegrals meshVolumeIntegrals(const TriangleMesh& mesh, const std::str
 /// MeshLoadError as meshVolumeIntegrals, and InvalidInertiaError if the
 /// result fails validateMassProperties (e.g. a self-intersecting mesh).
 MassProperties meshMassProperties(double density, const TriangleMesh& mesh, const std::string& where = "mesh");
-
-/// Winding number of a closed mesh about a point, counted along the ray
-/// from the point in +x with the ray/triangle test of particleMassProperties:
-///   w = sum over crossings with x_c > point_x of (+1 if the triangle's
-///       normal has n_x > 0, else -1),
-/// so w = 1 inside an outward-oriented mesh, -1 inside an inward one and 0
-/// outside. Ties are broken as for the perturbed point
-/// (x, y + e, z + e^2), e -> 0+, with a crossing at x_c = point_x not
-/// counted: a point on a face parallel to x, an edge or a vertex still gets
-/// a consistent answer, and a ray through an edge or vertex counts once.
-/// Precondition: validateClosedMesh(mesh) passed (not re-checked, O(T)).
-/// Throws InvalidArgumentError for a non-finite point.
-int meshWindingNumber(const TriangleMesh& mesh, const Eigen::Vector3d& point);
-
-/// Result of particleMassProperties.
-struct ParticleMassProperties
-{
-  MassProperties mass_properties;  ///< eq. (17) over the samples, in the mesh frame
-  std::size_t num_samples = 0;     ///< particles inside the mesh
-  double cell_size = 0.0;          ///< grid spacing h [m]
-  double particle_mass = 0.0;      ///< rho h^3 [kg]
-  /// Position of grid sample (0, 0, 0) [m]: sample (i, j, k) is at
-  /// grid_origin + h (i, j, k); every sample used has i, j, k >= 0.
-  Eigen::Vector3d grid_origin = Eigen::Vector3d::Zero();
-};
-
-/// The seed paper's particle approximation, eq. (17):
-///   m   = sum_i m_i,    com = (1/m) sum_i m_i p_i,
-///   I'  = sum_i m_i (p_i^T p_i I3 - p_i p_i^T),  p_i measured from com,
-/// with one particle of mass m_i = rho h^3 at every point of a regular grid
-/// that lies inside the closed mesh. h = cbrt(V / target_samples), so about
-/// target_samples points fall inside. The grid is offset from the bounding
-/// box corner by irrational-looking fractions of h so that rays rarely meet
-/// vertices or edges exactly.
-///
-/// Inside points are found by scanline ray casting: triangles are binned by
-/// their (y, z) bounding box into grid rows; each row's x-parallel ray is
-/// crossed with its triangles, the crossings sorted, and the samples
-/// between crossings of non-zero winding number are taken. Ray/triangle
-/// tests use edge functions evaluated identically for both triangles of a
-/// shared edge, with a symbolic perturbation of the ray for exact ties, so a
-/// ray through an edge or vertex is counted once. Collinear samples are
-/// summed in closed form (the same sum, evaluated per run) and runs are
-/// merged with the parallel-axis theorem, so the cost is
-/// O(triangles x rows each covers + rows log) and not O(samples).
-///
-/// Throws InvalidArgumentError for a density not finite and > 0, a
-/// target_samples of 0, or a grid too large for memory (over 2^24 rows or
-/// 2^26 triangle-row entries, e.g. a huge target on a long thin mesh); MeshLoadError as meshVolumeIntegrals (the mesh must be closed);
-/// InvalidArgumentError if no sample falls inside. The result is not
-/// validated: a handful of samples may give a singular inertia.
-ParticleMassProperties particleMassProperties(double density, const TriangleMesh& mesh, std::size_t target_samples,
-                                              const std::string& where = "mesh");
 
 }  // namespace diff_rigid_body

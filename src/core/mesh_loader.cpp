@@ -18,27 +18,6 @@ namespace
 {
 constexpr double kPi = 3.14159265358979323846;
 
-struct PositionHash
-{
-  std::size_t operator()(const Eigen::Vector3d& p) const
-  {
-    std::size_t seed = 0;
-    for (int i = 0; i < 3; ++i)
-    {
-      double value = p[i] == 0.0 ? 0.0 : p[i];  // +0 and -0 are the same position
-      std::uint64_t bits;
-      std::memcpy(&bits, &value, sizeof bits);
-      seed ^= std::hash<std::uint64_t>()(bits) + 0x9e3779b97f4a7c15ULL + (seed << 6) + (seed >> 2);
-    }
-    return seed;
-  }
-};
-
-struct PositionEqual
-{
-  bool operator()(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const { return (a.array() == b.array()).all(); }
-};
-
 // Appends the triangles of `node` and its children, in node order, placed by
 // the accumulated node transform.
 void collectTriangles(const aiScene& scene, const aiNode& node, const aiMatrix4x4& parent_transform,
@@ -64,33 +43,6 @@ void collectTriangles(const aiScene& scene, const aiNode& node, const aiMatrix4x
     collectTriangles(scene, *node.mChildren[c], transform, corners);
 }
 }  // namespace
-
-TriangleMesh joinIdenticalVertices(const TriangleMesh& mesh)
-{
-  std::unordered_map<Eigen::Vector3d, std::uint32_t, PositionHash, PositionEqual> index_of;
-  index_of.reserve(static_cast<std::size_t>(mesh.vertices.cols()));
-  std::vector<std::uint32_t> remap(static_cast<std::size_t>(mesh.vertices.cols()));
-  std::vector<Eigen::Index> kept;
-  for (Eigen::Index v = 0; v < mesh.vertices.cols(); ++v)
-  {
-    const auto inserted = index_of.emplace(mesh.vertices.col(v), static_cast<std::uint32_t>(kept.size()));
-    if (inserted.second)
-      kept.push_back(v);
-    remap[static_cast<std::size_t>(v)] = inserted.first->second;
-  }
-  TriangleMesh joined;
-  joined.vertices.resize(3, static_cast<Eigen::Index>(kept.size()));
-  for (std::size_t i = 0; i < kept.size(); ++i)
-    joined.vertices.col(static_cast<Eigen::Index>(i)) = mesh.vertices.col(kept[i]);
-  joined.triangles.reserve(mesh.triangles.size());
-  for (const auto& triangle : mesh.triangles)
-  {
-    const std::array<std::uint32_t, 3> t = { remap[triangle[0]], remap[triangle[1]], remap[triangle[2]] };
-    if (t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
-      joined.triangles.push_back(t);
-  }
-  return joined;
-}
 
 TriangleMesh loadMeshFile(const std::string& path, const Eigen::Vector3d& scale)
 {

@@ -8,20 +8,11 @@
 #include <Eigen/Eigenvalues>
 
 #include "diff_rigid_body/exceptions.h"
+#include "value_checks.h"
 
 namespace diff_rigid_body
 {
-namespace
-{
-std::string formatMatrix(const Eigen::Matrix3d& m)
-{
-  std::ostringstream out;
-  out.precision(17);
-  out << "[[" << m(0, 0) << ", " << m(0, 1) << ", " << m(0, 2) << "], [" << m(1, 0) << ", " << m(1, 1) << ", "
-      << m(1, 2) << "], [" << m(2, 0) << ", " << m(2, 1) << ", " << m(2, 2) << "]]";
-  return out.str();
-}
-}  // namespace
+using detail::formatMatrix;
 
 std::vector<std::string> checkMassProperties(const std::string& where, double mass, const Eigen::Matrix3d& inertia)
 {

@@ -22,6 +22,7 @@
 
 #include "diff_rigid_body/mass_matrix.h"
 #include "diff_rigid_body/vertex_jacobian.h"
+#include "reference/gimbal_lock.h"
 #include "../support/oracles.h"
 
 namespace drb = diff_rigid_body;

@@ -27,6 +27,7 @@
 
 #include "diff_rigid_body/exceptions.h"
 #include "diff_rigid_body/mass_properties.h"
+#include "reference/particle_mass_properties.h"
 #include "../support/expect_throws.h"
 
 using diff_rigid_body::boxMassProperties;
