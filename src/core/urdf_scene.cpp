@@ -9,14 +9,17 @@
 #include <unordered_map>
 
 #include <Eigen/Eigenvalues>
-#include <console_bridge/console.h>
-#include <tinyxml2.h>
-#include <urdf_parser/urdf_parser.h>
+#include <urdf_world/types.h>
+#include <urdf_model/model.h>
 
 #include "diff_rigid_body/exceptions.h"
 #include "diff_rigid_body/mass_properties.h"
 #include "diff_rigid_body/mesh_loader.h"
 #include "diff_rigid_body/rpy.h"
+#include "body_names.h"
+#include "identical_positions.h"
+#include "link_geometry.h"
+#include "urdf_model.h"
 
 namespace diff_rigid_body
 {
@@ -25,100 +28,18 @@ namespace
 /// [rad] A floating body whose initial pitch is this close to +-pi/2 loads with a warning.
 constexpr double kGimbalLockWarningAngle = 1e-6;
 
-// Collects urdfdom's console_bridge errors while it parses, so that they can
-// be quoted in the exception instead of only reaching stderr.
-class CapturedUrdfdomErrors : public console_bridge::OutputHandler
-{
-public:
-  CapturedUrdfdomErrors() { console_bridge::useOutputHandler(this); }
-  ~CapturedUrdfdomErrors() override { console_bridge::restorePreviousOutputHandler(); }
-  void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override
-  {
-    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR)
-      text_ += (text_.empty() ? "" : "; ") + text;
-  }
-  const std::string& text() const { return text_; }
-
-private:
-  std::string text_;
-};
-
-Eigen::Isometry3d toIsometry(const urdf::Pose& pose)
-{
-  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  X.linear() = Eigen::Quaterniond(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z)
-                   .normalized()
-                   .toRotationMatrix();
-  X.translation() << pose.position.x, pose.position.y, pose.position.z;
-  return X;
-}
-
-const char* jointTypeName(int type)
-{
-  switch (type)
-  {
-    case urdf::Joint::REVOLUTE:
-      return "revolute";
-    case urdf::Joint::CONTINUOUS:
-      return "continuous";
-    case urdf::Joint::PRISMATIC:
-      return "prismatic";
-    case urdf::Joint::FLOATING:
-      return "floating";
-    case urdf::Joint::PLANAR:
-      return "planar";
-    case urdf::Joint::FIXED:
-      return "fixed";
-    default:
-      return "unknown";
-  }
-}
-
 bool isFixed(const urdf::JointConstSharedPtr& joint)
 {
   return joint && joint->type == urdf::Joint::FIXED;
 }
 
-// Link names in document order (urdfdom keeps them in a std::map).
-std::vector<std::string> linkNamesInDocumentOrder(const std::string& urdf_xml)
-{
-  tinyxml2::XMLDocument document;
-  if (document.Parse(urdf_xml.c_str(), urdf_xml.size()) != tinyxml2::XML_SUCCESS)
-  {
-    std::ostringstream why;
-    why << "robot description: malformed XML at line " << document.ErrorLineNum() << ": " << document.ErrorStr();
-    throw SceneDescriptionError(why.str());
-  }
-  const tinyxml2::XMLElement* robot = document.FirstChildElement("robot");
-  if (!robot)
-    throw SceneDescriptionError("robot description: no <robot> element");
-  std::vector<std::string> names;
-  for (const tinyxml2::XMLElement* link = robot->FirstChildElement("link"); link;
-       link = link->NextSiblingElement("link"))
-  {
-    const char* name = link->Attribute("name");
-    if (name)
-      names.emplace_back(name);
-  }
-  return names;
-}
-
 class SceneBuilder
 {
 public:
-  SceneBuilder(const std::string& urdf_xml, const SceneOptions& options) : options_(options)
+  SceneBuilder(const std::string& urdf_xml, const SceneOptions& options) : options_(options), meshes_(options)
   {
-    document_order_ = linkNamesInDocumentOrder(urdf_xml);
-    {
-      CapturedUrdfdomErrors errors;
-      model_ = urdf::parseURDF(urdf_xml);
-      // urdfdom may log an error and still return a model in which the bad
-      // element is silently reset or dropped (e.g. mass="nan" becomes 0, a
-      // <box size="nan 1 1"> disappears): any logged error refuses it.
-      if (!model_ || !errors.text().empty())
-        throw SceneDescriptionError("robot description: urdfdom rejected it: " +
-                                    (errors.text().empty() ? std::string("(no reason given)") : errors.text()));
-    }
+    document_order_ = detail::linkNamesInDocumentOrder(urdf_xml);
+    model_ = detail::parseUrdfModel(urdf_xml);
     if (!model_->getRoot())
       throw SceneDescriptionError("robot description: no root link");
     if (options_.density && !(std::isfinite(*options_.density) && *options_.density > 0.0))
@@ -163,12 +84,8 @@ public:
     for (const std::string& name : options_.bodies)
     {
       if (std::find(body_links.begin(), body_links.end(), name) == body_links.end())
-      {
-        std::string known;
-        for (const auto& b : body_links)
-          known += (known.empty() ? "" : ", ") + b;
-        throw SceneDescriptionError("parameter bodies: unknown body '" + name + "' (bodies: " + known + ")");
-      }
+        throw SceneDescriptionError("parameter bodies: unknown body '" + name +
+                                    "' (bodies: " + detail::formatBodyNames(body_links) + ")");
     }
 
     for (const std::string& name : body_links)
@@ -178,7 +95,7 @@ public:
       scene.bodies.push_back(buildBody(name, fixed_from_root));
       const urdf::JointConstSharedPtr& joint = model_->getLink(name)->parent_joint;
       if (joint->type != urdf::Joint::FLOATING)
-        scene.unmodelled_joints.push_back("joint '" + joint->name + "' (" + jointTypeName(joint->type) +
+        scene.unmodelled_joints.push_back("joint '" + joint->name + "' (" + detail::jointTypeName(joint->type) +
                                           "): its constraint is not modelled; child '" + name +
                                           "' is a free body posed at joint value 0");
     }
@@ -210,134 +127,11 @@ private:
       for (auto joint = next.link->child_joints.rbegin(); joint != next.link->child_joints.rend(); ++joint)
       {
         const urdf::LinkConstSharedPtr child = model_->getLink((*joint)->child_link_name);
-        const Eigen::Isometry3d child_pose = next.pose * toIsometry((*joint)->parent_to_joint_origin_transform);
+        const Eigen::Isometry3d child_pose = next.pose * detail::toIsometry((*joint)->parent_to_joint_origin_transform);
         if (!child_pose.matrix().allFinite())
           throw SceneDescriptionError("joint '" + (*joint)->name + "': <origin> is not finite");
         stack.push_back({ child, child_pose, isFixed(*joint) ? next.owner : child->name });
       }
-    }
-  }
-
-  const TriangleMesh& meshFile(const urdf::Mesh& mesh, const std::string& link_name)
-  {
-    const std::string path = resolvePath(mesh.filename, link_name);
-    const Eigen::Vector3d scale(mesh.scale.x, mesh.scale.y, mesh.scale.z);
-    const auto key = std::make_pair(path, std::array<double, 3>{ scale.x(), scale.y(), scale.z() });
-    auto found = mesh_cache_.find(key);
-    if (found == mesh_cache_.end())
-    {
-      try
-      {
-        found = mesh_cache_.emplace(key, loadMeshFile(path, scale)).first;
-      }
-      catch (const MeshLoadError& e)
-      {
-        throw MeshLoadError("link '" + link_name + "': " + e.what());
-      }
-    }
-    return found->second;
-  }
-
-  std::string resolvePath(const std::string& uri, const std::string& link_name) const
-  {
-    const std::string package_scheme = "package://";
-    const std::string file_scheme = "file://";
-    if (uri.rfind(package_scheme, 0) == 0)
-    {
-      const std::string rest = uri.substr(package_scheme.size());
-      const std::size_t slash = rest.find('/');
-      const std::string package = rest.substr(0, slash);
-      std::string root;
-      if (options_.find_package)
-      {
-        try
-        {
-          root = options_.find_package(package);
-        }
-        catch (const std::exception&)
-        {
-          root.clear();
-        }
-      }
-      if (root.empty())
-        throw MeshLoadError("link '" + link_name + "': mesh '" + uri + "': cannot find package '" + package + "'");
-      return root + (slash == std::string::npos ? "" : rest.substr(slash));
-    }
-    if (uri.rfind(file_scheme, 0) == 0)
-      return uri.substr(file_scheme.size());
-    if (!uri.empty() && uri[0] == '/')
-      return uri;
-    if (!options_.base_directory.empty())
-      return options_.base_directory + "/" + uri;
-    throw MeshLoadError("link '" + link_name + "': mesh '" + uri +
-                        "': relative path with no base folder (use package://, file:// or an absolute path)");
-  }
-
-  // Geometry of one <collision> or <visual> element in its own frame.
-  TriangleMesh geometryMesh(const urdf::Geometry& geometry, const std::string& link_name)
-  {
-    // A primitive size must be finite and > 0 [m].
-    auto require_size = [&link_name](const char* what, double value) {
-      if (!(std::isfinite(value) && value > 0.0))
-      {
-        std::ostringstream why;
-        why << "link '" << link_name << "': " << what << " must be finite and > 0 m, got " << value;
-        throw SceneDescriptionError(why.str());
-      }
-    };
-    switch (geometry.type)
-    {
-      case urdf::Geometry::BOX:
-      {
-        const auto& box = static_cast<const urdf::Box&>(geometry);
-        require_size("box size x", box.dim.x);
-        require_size("box size y", box.dim.y);
-        require_size("box size z", box.dim.z);
-        return boxMesh(Eigen::Vector3d(box.dim.x, box.dim.y, box.dim.z));
-      }
-      case urdf::Geometry::SPHERE:
-        require_size("sphere radius", static_cast<const urdf::Sphere&>(geometry).radius);
-        return sphereMesh(static_cast<const urdf::Sphere&>(geometry).radius);
-      case urdf::Geometry::CYLINDER:
-      {
-        const auto& cylinder = static_cast<const urdf::Cylinder&>(geometry);
-        require_size("cylinder radius", cylinder.radius);
-        require_size("cylinder length", cylinder.length);
-        return cylinderMesh(cylinder.radius, cylinder.length);
-      }
-      case urdf::Geometry::MESH:
-        return meshFile(static_cast<const urdf::Mesh&>(geometry), link_name);
-    }
-    throw SceneDescriptionError("link '" + link_name + "': unknown geometry type");
-  }
-
-  // Mass properties of one geometry element in its own frame, for a density.
-  MassProperties geometryMassProperties(const urdf::Geometry& geometry, const TriangleMesh& mesh, double density,
-                                        const std::string& link_name)
-  {
-    try
-    {
-      switch (geometry.type)
-      {
-        case urdf::Geometry::BOX:
-        {
-          const auto& box = static_cast<const urdf::Box&>(geometry);
-          return boxMassProperties(density, Eigen::Vector3d(box.dim.x, box.dim.y, box.dim.z));
-        }
-        case urdf::Geometry::SPHERE:
-          return sphereMassProperties(density, static_cast<const urdf::Sphere&>(geometry).radius);
-        case urdf::Geometry::CYLINDER:
-        {
-          const auto& cylinder = static_cast<const urdf::Cylinder&>(geometry);
-          return cylinderMassProperties(density, cylinder.radius, cylinder.length);
-        }
-        default:
-          return meshMassProperties(density, mesh);
-      }
-    }
-    catch (const Error& e)
-    {
-      throw InvalidInertiaError("link '" + link_name + "': cannot compute inertia from its geometry: " + e.what());
     }
   }
 
@@ -347,7 +141,7 @@ private:
     scene_body.body.name = body_name;
     const urdf::JointConstSharedPtr& joint = model_->getLink(body_name)->parent_joint;
     scene_body.joint_name = joint->name;
-    scene_body.joint_type = jointTypeName(joint->type);
+    scene_body.joint_type = detail::jointTypeName(joint->type);
 
     const Eigen::Isometry3d body_in_root = pose_in_root_.at(body_name);
     std::vector<std::pair<Eigen::Isometry3d, MassProperties>> link_masses;
@@ -395,16 +189,16 @@ private:
                                  std::vector<std::pair<std::size_t, Eigen::Vector3d>>& link_vertices)
   {
     std::vector<std::pair<Eigen::Isometry3d, MassProperties>> geometry_masses;
-    for (const auto& [origin, geometry] : linkGeometries(link))
+    for (const auto& [origin, geometry] : detail::linkGeometries(link, options_.geometry))
     {
       if (!origin.matrix().allFinite())
         throw SceneDescriptionError("link '" + link.name + "': geometry <origin> is not finite");
-      const TriangleMesh mesh = geometryMesh(*geometry, link.name);
+      const TriangleMesh mesh = meshes_.mesh(*geometry, link.name);
       const Eigen::Isometry3d in_body_link = pose_in_body_link * origin;
       for (Eigen::Index v = 0; v < mesh.vertices.cols(); ++v)
         link_vertices.emplace_back(slot, in_body_link * mesh.vertices.col(v));
       if (!link.inertial && options_.density)
-        geometry_masses.emplace_back(origin, geometryMassProperties(*geometry, mesh, *options_.density, link.name));
+        geometry_masses.emplace_back(origin, detail::geometryMassProperties(*geometry, mesh, *options_.density, link.name));
     }
     if (link.inertial)
       return inertialMassProperties(link.name, *link.inertial);
@@ -420,7 +214,7 @@ private:
   // <inertial> in the link frame: I_link = R_o I R_o^T about the COM.
   MassProperties inertialMassProperties(const std::string& link_name, const urdf::Inertial& inertial)
   {
-    const Eigen::Isometry3d frame = toIsometry(inertial.origin);
+    const Eigen::Isometry3d frame = detail::toIsometry(inertial.origin);
     if (!frame.matrix().allFinite())
       throw InvalidInertiaError("link '" + link_name + "' <inertial>: <origin> is not finite");
     Eigen::Matrix3d inertia;
@@ -467,23 +261,21 @@ private:
   void joinBodyVertices(const std::vector<std::pair<std::size_t, Eigen::Vector3d>>& link_vertices,
                         const Eigen::Vector3d& com, SceneBody& scene_body) const
   {
-    std::map<std::array<double, 3>, std::uint32_t> index_of;
-    std::vector<Eigen::Vector3d> unique;
-    for (const auto& [slot, position] : link_vertices)
+    Matrix3X<double> points(3, static_cast<Eigen::Index>(link_vertices.size()));
+    for (std::size_t k = 0; k < link_vertices.size(); ++k)
+      points.col(static_cast<Eigen::Index>(k)) = link_vertices[k].second - com;
+    const detail::IdenticalPositions positions = detail::joinIdenticalPositions(points);
+    for (std::size_t k = 0; k < link_vertices.size(); ++k)
     {
-      const Eigen::Vector3d p = position - com;
-      const std::array<double, 3> key{ p.x() + 0.0, p.y() + 0.0, p.z() + 0.0 };  // + 0.0 folds -0 into +0
-      const auto inserted = index_of.emplace(key, static_cast<std::uint32_t>(unique.size()));
-      if (inserted.second)
-      {
-        unique.push_back(p);
-        ++scene_body.links[slot].new_vertex_count;
-      }
-      scene_body.links[slot].vertex_indices.push_back(inserted.first->second);
+      LinkInBody& link = scene_body.links[link_vertices[k].first];
+      const std::uint32_t position = positions.position_of[k];
+      if (positions.first_point[position] == static_cast<Eigen::Index>(k))
+        ++link.new_vertex_count;
+      link.vertex_indices.push_back(position);
     }
-    scene_body.body.vertices.resize(3, static_cast<Eigen::Index>(unique.size()));
-    for (std::size_t i = 0; i < unique.size(); ++i)
-      scene_body.body.vertices.col(static_cast<Eigen::Index>(i)) = unique[i];
+    scene_body.body.vertices.resize(3, static_cast<Eigen::Index>(positions.first_point.size()));
+    for (std::size_t i = 0; i < positions.first_point.size(); ++i)
+      scene_body.body.vertices.col(static_cast<Eigen::Index>(i)) = points.col(positions.first_point[i]);
     if (!scene_body.body.vertices.allFinite())
       throw SceneDescriptionError("body '" + scene_body.body.name +
                                   "': vertex coordinates overflow (check mesh scales)");
@@ -513,29 +305,13 @@ private:
     warnings_.push_back(finding + "; " + consequence + " (~strict_inertia: true refuses it)");
   }
 
-  // The link's chosen geometry elements (collision or visual, falling back to
-  // the other kind), each with its origin in the link frame.
-  std::vector<std::pair<Eigen::Isometry3d, const urdf::Geometry*>> linkGeometries(const urdf::Link& link) const
-  {
-    std::vector<std::pair<Eigen::Isometry3d, const urdf::Geometry*>> collisions, visuals;
-    for (const auto& c : link.collision_array)
-      if (c && c->geometry)
-        collisions.emplace_back(toIsometry(c->origin), c->geometry.get());
-    for (const auto& v : link.visual_array)
-      if (v && v->geometry)
-        visuals.emplace_back(toIsometry(v->origin), v->geometry.get());
-    if (options_.geometry == GeometrySource::Collision)
-      return collisions.empty() ? visuals : collisions;
-    return visuals.empty() ? collisions : visuals;
-  }
-
   const SceneOptions& options_;
   urdf::ModelInterfaceSharedPtr model_;
   std::vector<std::string> document_order_;
   std::unordered_map<std::string, Eigen::Isometry3d> pose_in_root_;
   std::unordered_map<std::string, std::string> owner_;
   std::unordered_map<std::string, std::vector<std::string>> merged_links_;  ///< body -> merged links, document order
-  std::map<std::pair<std::string, std::array<double, 3>>, TriangleMesh> mesh_cache_;
+  detail::GeometryMeshes meshes_;
   std::vector<std::string> warnings_;
 };
 

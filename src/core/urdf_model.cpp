@@ -1,0 +1,94 @@
+#include "urdf_model.h"
+
+#include <sstream>
+#include <utility>
+
+#include <console_bridge/console.h>
+#include <tinyxml2.h>
+#include <urdf_parser/urdf_parser.h>
+
+#include "diff_rigid_body/exceptions.h"
+
+namespace diff_rigid_body
+{
+namespace
+{
+// Collects urdfdom's console_bridge errors while it parses, so that they can
+// be quoted in the exception instead of only reaching stderr.
+class CapturedUrdfdomErrors : public console_bridge::OutputHandler
+{
+public:
+  CapturedUrdfdomErrors() { console_bridge::useOutputHandler(this); }
+  ~CapturedUrdfdomErrors() override { console_bridge::restorePreviousOutputHandler(); }
+  void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override
+  {
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR)
+      text_ += (text_.empty() ? "" : "; ") + text;
+  }
+  const std::string& text() const { return text_; }
+
+private:
+  std::string text_;
+};
+
+}  // namespace
+
+namespace detail
+{
+urdf::ModelInterfaceSharedPtr parseUrdfModel(const std::string& urdf_xml)
+{
+  CapturedUrdfdomErrors errors;
+  urdf::ModelInterfaceSharedPtr model = urdf::parseURDF(urdf_xml);
+  if (!model || !errors.text().empty())
+    throw SceneDescriptionError("robot description: urdfdom rejected it: " +
+                                (errors.text().empty() ? std::string("(no reason given)") : errors.text()));
+  return model;
+}
+
+std::vector<std::string> linkNamesInDocumentOrder(const std::string& urdf_xml)
+{
+  tinyxml2::XMLDocument document;
+  if (document.Parse(urdf_xml.c_str(), urdf_xml.size()) != tinyxml2::XML_SUCCESS)
+  {
+    std::ostringstream why;
+    why << "robot description: malformed XML at line " << document.ErrorLineNum() << ": " << document.ErrorStr();
+    throw SceneDescriptionError(why.str());
+  }
+  const tinyxml2::XMLElement* robot = document.FirstChildElement("robot");
+  if (!robot)
+    throw SceneDescriptionError("robot description: no <robot> element");
+  std::vector<std::string> names;
+  for (const tinyxml2::XMLElement* link = robot->FirstChildElement("link"); link;
+       link = link->NextSiblingElement("link"))
+  {
+    const char* name = link->Attribute("name");
+    if (name)
+      names.emplace_back(name);
+  }
+  return names;
+}
+
+Eigen::Isometry3d toIsometry(const urdf::Pose& pose)
+{
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = Eigen::Quaterniond(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z)
+                   .normalized()
+                   .toRotationMatrix();
+  X.translation() << pose.position.x, pose.position.y, pose.position.z;
+  return X;
+}
+
+const char* jointTypeName(int type)
+{
+  static const std::pair<int, const char*> kNames[] = {
+    { urdf::Joint::REVOLUTE, "revolute" }, { urdf::Joint::CONTINUOUS, "continuous" },
+    { urdf::Joint::PRISMATIC, "prismatic" }, { urdf::Joint::FLOATING, "floating" },
+    { urdf::Joint::PLANAR, "planar" },     { urdf::Joint::FIXED, "fixed" },
+  };
+  for (const auto& [value, name] : kNames)
+    if (value == type)
+      return name;
+  return "unknown";
+}
+}  // namespace detail
+}  // namespace diff_rigid_body
