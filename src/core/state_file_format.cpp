@@ -1,0 +1,257 @@
+// The state file's text: fingerprint, CRC, formatting and parsing
+// (include/diff_rigid_body/state_file.h; file I/O in state_file_io.cpp).
+#include <cmath>
+#include <cstring>
+#include <utility>
+#include <vector>
+
+#include "body_names.h"
+#include "diff_rigid_body/state_file.h"
+#include "state_file_tokens.h"
+
+namespace diff_rigid_body
+{
+namespace
+{
+const char* const kHeader = "diff_rigid_body state file v1";
+
+[[noreturn]] void fail(const std::string& message)
+{
+  throw StateFileError(message);
+}
+
+// 64-bit FNV-1a.
+class Fnv1a
+{
+public:
+  void bytes(const void* data, std::size_t size)
+  {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < size; ++i)
+    {
+      hash_ ^= p[i];
+      hash_ *= 0x100000001b3ULL;
+    }
+  }
+  void number(std::uint64_t value) { bytes(&value, sizeof value); }
+  void number(double value)
+  {
+    std::uint64_t bits;
+    std::memcpy(&bits, &value, sizeof bits);
+    number(bits);
+  }
+  void text(const std::string& value)
+  {
+    number(static_cast<std::uint64_t>(value.size()));
+    bytes(value.data(), value.size());
+  }
+  std::uint64_t value() const { return hash_; }
+
+private:
+  std::uint64_t hash_ = 0xcbf29ce484222325ULL;
+};
+
+}  // namespace
+
+using namespace detail;
+
+std::size_t maxStateFileSize(std::size_t body_count)
+{
+  return 65536 + 4096 * body_count;
+}
+
+std::uint64_t sceneFingerprint(const Scene& scene)
+{
+  Fnv1a hash;
+  hash.text(kHeader);
+  hash.text(scene.fixed_frame);
+  hash.number(static_cast<std::uint64_t>(scene.bodies.size()));
+  for (const SceneBody& scene_body : scene.bodies)
+  {
+    const RigidBody& body = scene_body.body;
+    hash.text(body.name);
+    hash.number(body.mass);
+    for (int i = 0; i < 9; ++i)
+      hash.number(body.inertia_body(i / 3, i % 3));
+    for (int i = 0; i < 3; ++i)
+      hash.number(body.com_offset[i]);
+    hash.number(static_cast<std::uint64_t>(body.vertices.cols()));
+    for (Eigen::Index v = 0; v < body.vertices.cols(); ++v)
+      for (int i = 0; i < 3; ++i)
+        hash.number(body.vertices(i, v));
+  }
+  return hash.value();
+}
+
+std::uint32_t crc32(const std::string& bytes)
+{
+  std::uint32_t crc = 0xffffffffu;
+  for (unsigned char c : bytes)
+  {
+    crc ^= c;
+    for (int bit = 0; bit < 8; ++bit)
+      crc = (crc >> 1) ^ (0xedb88320u & (0u - (crc & 1u)));
+  }
+  return crc ^ 0xffffffffu;
+}
+
+std::string formatStateFile(const Scene& scene, const SceneState& state)
+{
+  if (state.size() != scene.bodies.size())
+    fail("cannot save a state of " + std::to_string(state.size()) + " bodies for a scene of " +
+         std::to_string(scene.bodies.size()));
+  std::string text = std::string(kHeader) + "\n";
+  text += "fingerprint " + hex(sceneFingerprint(scene), 16) + "\n";
+  text += "bodies " + std::to_string(state.size()) + "\n";
+  for (std::size_t i = 0; i < state.size(); ++i)
+  {
+    text += "body " + encodeName(scene.bodies[i].body.name);
+    for (int k = 0; k < 6; ++k)
+    {
+      if (!std::isfinite(state[i][k]))
+        fail("cannot save a non-finite q[" + std::to_string(k) + "] of body '" + scene.bodies[i].body.name + "'");
+      text += " " + formatValue(state[i][k]);
+    }
+    text += "\n";
+  }
+  text += "end " + std::to_string(state.size()) + " crc32 " + hex(crc32(text), 8) + "\n";
+  return text;
+}
+
+namespace
+{
+/// The lines of `text` (without their '\n') and where each starts, after
+/// the checks that need no parsing: size, not empty, a final line end.
+struct Lines
+{
+  std::vector<std::string> text;
+  std::vector<std::size_t> starts;
+};
+
+Lines splitLines(const std::string& text, const Scene& scene)
+{
+  if (text.size() > maxStateFileSize(scene.bodies.size()))
+    fail("too large: " + std::to_string(text.size()) + " bytes, at most " +
+         std::to_string(maxStateFileSize(scene.bodies.size())) + " for " + std::to_string(scene.bodies.size()) +
+         " bodies");
+  if (text.empty())
+    fail("empty file");
+  if (text.back() != '\n')
+    fail("truncated: the last line has no line end (the file was cut short)");
+  Lines lines;
+  for (std::size_t start = 0; start < text.size();)
+  {
+    const std::size_t end = text.find('\n', start);
+    lines.text.push_back(text.substr(start, end - start));
+    lines.starts.push_back(start);
+    start = end + 1;
+  }
+  return lines;
+}
+
+/// Checks the trailer "end <count> crc32 <crc>" against the bytes before it
+/// and returns its count: a file cut short or damaged is reported as such,
+/// before any of its contents is interpreted.
+std::size_t checkTrailer(const std::string& text, const Lines& lines)
+{
+  const std::string& trailer = lines.text.back();
+  const std::vector<std::string> tokens = splitTokens(trailer);
+  if (tokens[0] != "end")
+    fail("truncated: no 'end' line (the file was cut short or has trailing data)");
+  std::size_t count = 0;
+  std::uint64_t stored_crc = 0;
+  if (tokens.size() != 4 || !parseCount(tokens[1], count) || tokens[2] != "crc32" ||
+      !parseHex(tokens[3], 8, stored_crc))
+    fail("line " + std::to_string(lines.text.size()) + ": expected 'end <count> crc32 <8 hex digits>', got '" +
+         quoted(trailer) + "'");
+  const std::uint32_t computed_crc = crc32(text.substr(0, lines.starts.back()));
+  if (computed_crc != stored_crc)
+    fail("checksum mismatch: the file is corrupt (crc32 " + hex(stored_crc, 8) + " stored, " +
+         hex(computed_crc, 8) + " computed)");
+  return count;
+}
+
+/// Lines 2 and 3, "fingerprint <hex>" and "bodies <count>", checked against
+/// the number of body lines and the trailer's count. Returns the fingerprint.
+std::uint64_t parseCounts(const Lines& lines, std::size_t end_count)
+{
+  if (lines.text.size() < 4)
+    fail("truncated: expected a fingerprint and a bodies line");
+  std::vector<std::string> tokens = splitTokens(lines.text[1]);
+  std::uint64_t fingerprint = 0;
+  if (tokens.size() != 2 || tokens[0] != "fingerprint" || !parseHex(tokens[1], 16, fingerprint))
+    fail("line 2: expected 'fingerprint <16 hex digits>', got '" + quoted(lines.text[1]) + "'");
+  tokens = splitTokens(lines.text[2]);
+  std::size_t count = 0;
+  if (tokens.size() != 2 || tokens[0] != "bodies" || !parseCount(tokens[1], count))
+    fail("line 3: expected 'bodies <count>', got '" + quoted(lines.text[2]) + "'");
+  const std::size_t body_lines = lines.text.size() - 4;
+  if (count != body_lines || end_count != count)
+    fail("body count mismatch: 'bodies " + std::to_string(count) + "', " + std::to_string(body_lines) +
+         " body lines, 'end " + std::to_string(end_count) + "'");
+  return fingerprint;
+}
+
+/// One "body <name> <6 hex floats>" line (line number `number`).
+NamedState parseBodyLine(const std::string& line, std::size_t number)
+{
+  const std::string where = "line " + std::to_string(number);
+  const std::vector<std::string> tokens = splitTokens(line);
+  if (tokens.size() != 8 || tokens[0] != "body")
+    fail(where + ": expected 'body <name> <6 hex floats>', got '" + quoted(line) + "'");
+  NamedState body;
+  if (!decodeName(tokens[1], body.name) || body.name.empty())
+    fail(where + ": malformed body name '" + quoted(tokens[1]) + "'");
+  for (int k = 0; k < 6; ++k)
+  {
+    if (!parseValue(tokens[2 + k], body.q[k]))
+      fail(where + ": q[" + std::to_string(k) + "] of body '" + quoted(body.name) + "': not a hex float: '" +
+           quoted(tokens[2 + k], 40) + "'");
+    if (!std::isfinite(body.q[k]))
+      fail(where + ": q[" + std::to_string(k) + "] of body '" + quoted(body.name) + "': not finite");
+  }
+  return body;
+}
+
+/// "[a, b, ...]": at most 20 names, quoted.
+std::string names(const std::vector<std::string>& list)
+{
+  return "[" + formatBodyNames(list.size(), [&list](std::size_t i) { return quoted(list[i]); }, 20) + "]";
+}
+
+/// Throws unless the file's bodies and fingerprint are the scene's.
+void checkSameScene(const std::vector<std::string>& file_names, std::uint64_t fingerprint, const Scene& scene)
+{
+  std::vector<std::string> scene_names;
+  for (const SceneBody& body : scene.bodies)
+    scene_names.push_back(body.body.name);
+  if (file_names != scene_names)
+    fail("saved for other bodies: the file has " + names(file_names) + ", the scene has " + names(scene_names));
+  const std::uint64_t expected = sceneFingerprint(scene);
+  if (fingerprint != expected)
+    fail("saved for another scene: fingerprint " + hex(fingerprint, 16) + ", the scene's is " + hex(expected, 16) +
+         " (same bodies, but their mass properties, vertices or fixed frame differ)");
+}
+}  // namespace
+
+SceneState parseStateFile(const std::string& text, const Scene& scene)
+{
+  const Lines lines = splitLines(text, scene);
+  if (lines.text[0] != kHeader)
+    fail("line 1: expected '" + std::string(kHeader) + "', got '" + quoted(lines.text[0]) + "'");
+  const std::size_t count = checkTrailer(text, lines);
+  const std::uint64_t fingerprint = parseCounts(lines, count);
+  std::vector<std::string> file_names;
+  SceneState state;
+  state.reserve(count);
+  for (std::size_t i = 0; i < count; ++i)
+  {
+    NamedState body = parseBodyLine(lines.text[i + 3], i + 4);
+    file_names.push_back(std::move(body.name));
+    state.push_back(body.q);
+  }
+  checkSameScene(file_names, fingerprint, scene);
+  return state;
+}
+
+}  // namespace diff_rigid_body
