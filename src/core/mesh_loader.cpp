@@ -1,6 +1,8 @@
 #include "diff_rigid_body/mesh_loader.h"
 
+#include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <cstring>
 #include <sstream>
 #include <unordered_map>
@@ -10,6 +12,7 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include "child_process.h"
 #include "diff_rigid_body/exceptions.h"
 
 namespace diff_rigid_body
@@ -17,6 +20,14 @@ namespace diff_rigid_body
 namespace
 {
 constexpr double kPi = 3.14159265358979323846;
+/// Mesh files over this size are refused before they are read [bytes].
+constexpr std::uintmax_t kMaxMeshFileBytes = std::uintmax_t(1) << 30;
+/// At most this many triangle corners from one file (2^24 triangles).
+constexpr std::size_t kMaxMeshCorners = std::size_t(3) << 24;
+/// A read that takes longer is abandoned (its child process killed).
+constexpr std::chrono::milliseconds kMeshReadTimeout{ 60000 };
+/// Memory the reading child may allocate beyond the parent's [bytes].
+constexpr std::size_t kMeshReadMemory = std::size_t(4) << 30;
 
 // Appends the triangles of `node` and its children, in node order, placed by
 // the accumulated node transform.
@@ -42,17 +53,10 @@ void collectTriangles(const aiScene& scene, const aiNode& node, const aiMatrix4x
   for (unsigned c = 0; c < node.mNumChildren; ++c)
     collectTriangles(scene, *node.mChildren[c], transform, corners);
 }
-}  // namespace
-
-TriangleMesh loadMeshFile(const std::string& path, const Eigen::Vector3d& scale)
+// The corners of every triangle of the file, 3 per triangle, in the file's
+// units and axes (assimp; see loadMeshFile).
+std::vector<Eigen::Vector3d> readTriangleCorners(const std::string& path)
 {
-  if (!scale.allFinite() || (scale.array() == 0.0).any())
-  {
-    std::ostringstream why;
-    why << "mesh '" << path << "': scale must be finite and non-zero in every axis, got (" << scale.transpose()
-        << ")";
-    throw MeshLoadError(why.str());
-  }
   Assimp::Importer importer;
   // Keep only positions: normals, colours and texture coordinates would stop
   // assimp from joining vertices and are not needed.
@@ -66,9 +70,60 @@ TriangleMesh loadMeshFile(const std::string& path, const Eigen::Vector3d& scale)
       importer.ReadFile(path, aiProcess_RemoveComponent | aiProcess_Triangulate | aiProcess_SortByPType);
   if (!scene || !scene->mRootNode)
     throw MeshLoadError("mesh '" + path + "': cannot be read: " + importer.GetErrorString());
-
   std::vector<Eigen::Vector3d> corners;
   collectTriangles(*scene, *scene->mRootNode, aiMatrix4x4(), corners);
+  return corners;
+}
+
+// readTriangleCorners in a child process (src/core/child_process.h): assimp's
+// importers can crash, loop or allocate without bound on malformed files
+// (docs/robustness.md, M rows); that refuses the file instead of ending the
+// caller's process. The corners come back as raw doubles.
+std::vector<Eigen::Vector3d> readTriangleCornersIsolated(const std::string& path)
+{
+  std::error_code error;
+  const std::uintmax_t bytes = std::filesystem::file_size(path, error);
+  if (!error && bytes > kMaxMeshFileBytes)
+    throw MeshLoadError("mesh '" + path + "': file of " + std::to_string(bytes) + " bytes is over the limit of " +
+                        std::to_string(kMaxMeshFileBytes) + " bytes");
+  std::string bytes_of_corners;
+  try
+  {
+    bytes_of_corners = runInChildProcess(
+        [&path] {
+          const std::vector<Eigen::Vector3d> corners = readTriangleCorners(path);
+          if (corners.size() > kMaxMeshCorners)
+            throw MeshLoadError("mesh '" + path + "': " + std::to_string(corners.size() / 3) +
+                                " triangles, over the limit of " + std::to_string(kMaxMeshCorners / 3));
+          return std::string(reinterpret_cast<const char*>(corners.data()), corners.size() * sizeof(Eigen::Vector3d));
+        },
+        kMeshReadTimeout, kMeshReadMemory);
+  }
+  catch (const ChildProcessFailure& e)
+  {
+    throw MeshLoadError("mesh '" + path + "': assimp's reader " + e.what() + "; the file is malformed or too large");
+  }
+  catch (const std::runtime_error& e)  // what readTriangleCorners threw, by message
+  {
+    throw MeshLoadError(e.what());
+  }
+  std::vector<Eigen::Vector3d> corners(bytes_of_corners.size() / sizeof(Eigen::Vector3d));
+  if (!corners.empty())
+    std::memcpy(static_cast<void*>(corners.data()), bytes_of_corners.data(), corners.size() * sizeof(Eigen::Vector3d));
+  return corners;
+}
+}  // namespace
+
+TriangleMesh loadMeshFile(const std::string& path, const Eigen::Vector3d& scale)
+{
+  if (!scale.allFinite() || (scale.array() == 0.0).any())
+  {
+    std::ostringstream why;
+    why << "mesh '" << path << "': scale must be finite and non-zero in every axis, got (" << scale.transpose()
+        << ")";
+    throw MeshLoadError(why.str());
+  }
+  const std::vector<Eigen::Vector3d> corners = readTriangleCornersIsolated(path);
   if (corners.empty())
     throw MeshLoadError("mesh '" + path + "': has no triangles");
 
