@@ -32,6 +32,35 @@ void writeRowMajor(const Matrix6<double>& M, double* out)
   Eigen::Map<Eigen::Matrix<double, 6, 6, Eigen::RowMajor>> target(out);
   target = M;
 }
+
+// M(q_k) and cos(theta_k) of one body for the states q_k = q + k stride,
+// k < count, by massMatrixBatch (mass_matrix.h: vectorised sinCos over
+// blocks of states, M written entry by entry). Matrix k goes to slot
+// k * slot_stride (36 doubles per slot, one cos_theta per slot): adjacent
+// slots are written in place; otherwise (several bodies per configuration)
+// blocks of states go through an L1 buffer and are copied to their slots.
+void bodyMassMatrices(const RigidBody& body, const double* q, std::size_t count, std::size_t stride,
+                      std::size_t slot_stride, double* mass_matrices, double* cos_theta)
+{
+  if (slot_stride == 1 || count == 1)
+  {
+    massMatrixBatch(q, count, stride, body.mass, body.inertia_body, mass_matrices, cos_theta);
+    return;
+  }
+  constexpr std::size_t kBlock = 64;  // 18 KiB of matrices
+  double block[36 * kBlock], cos_block[kBlock];
+  for (std::size_t k0 = 0; k0 < count; k0 += kBlock)
+  {
+    const std::size_t m = std::min(kBlock, count - k0);
+    massMatrixBatch(q + k0 * stride, m, stride, body.mass, body.inertia_body, block, cos_block);
+    for (std::size_t j = 0; j < m; ++j)
+    {
+      const std::size_t slot = (k0 + j) * slot_stride;
+      std::copy(block + 36 * j, block + 36 * (j + 1), mass_matrices + 36 * slot);
+      cos_theta[slot] = cos_block[j];
+    }
+  }
+}
 }  // namespace
 
 void requireFinite(const double* values, std::size_t count, const std::string& field)
@@ -161,23 +190,21 @@ MassMatrixAnswer SceneQueries::massMatrices(const SceneState& current, const std
   answer.cos_theta.resize(matrices);
   if (derivatives)
     answer.derivatives.resize(216 * matrices);
-  for (std::size_t k = 0; k < configurations; ++k)
+  // Body i's states: q + 6 i, 6 n apart (slot k n + i), or its current state.
+  for (std::size_t i = 0; i < n; ++i)
+    bodyMassMatrices(scene_.bodies[indices[i]].body, q.empty() ? current[indices[i]].data() : q.data() + 6 * i,
+                     configurations, 6 * n, n, answer.mass_matrices.data() + 36 * i, answer.cos_theta.data() + i);
+  if (derivatives)
   {
-    for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t slot = 0; slot < matrices; ++slot)
     {
-      const RigidBody& body = scene_.bodies[indices[i]].body;
-      const std::size_t slot = k * n + i;
-      const double phi = q.empty() ? current[indices[i]][PHI] : q[6 * slot + PHI];
-      const double theta = q.empty() ? current[indices[i]][THETA] : q[6 * slot + THETA];
-      const RpyTrig<double> trig(phi, theta, 0.0);
-      writeRowMajor(massMatrix(trig, body.mass, body.inertia_body), answer.mass_matrices.data() + 36 * slot);
-      answer.cos_theta[slot] = trig.c_theta;
-      if (derivatives)
-      {
-        const std::array<Matrix6<double>, 6> dM = massMatrixDerivatives(trig, body.inertia_body);
-        for (int j = 0; j < 6; ++j)
-          writeRowMajor(dM[j], answer.derivatives.data() + 216 * slot + 36 * j);
-      }
+      const std::size_t i = slot % n;
+      const double* qs = q.empty() ? current[indices[i]].data() : q.data() + 6 * slot;
+      const RpyTrig<double> trig(qs[PHI], qs[THETA], 0.0);
+      const std::array<Matrix6<double>, 6> dM =
+          massMatrixDerivatives(trig, scene_.bodies[indices[i]].body.inertia_body);
+      for (int j = 0; j < 6; ++j)
+        writeRowMajor(dM[j], answer.derivatives.data() + 216 * slot + 36 * j);
     }
   }
   // Finite inputs can still overflow (e.g. an inertia near DBL_MAX): never
@@ -279,10 +306,9 @@ Vector6<double> SceneQueries::backprop(const SceneState& current, const std::str
   if (gradients.size() != 3 * count)
     reject(sizeMismatch("gradients", "3 per vertex = " + std::to_string(3 * count), gradients.size()));
   const BodyPose<double> pose(stateOrCurrent(current, index, q));
+  // All vertices or an index list: the by-coordinate engine (vertex_columns.h).
   const Vector6<double> gradient =
-      vertices.empty() ? backpropagateVertexGradients(pose, vertex_columns_[index], gradients.data())
-                       : backpropagateVertexGradients(pose, scene_.bodies[index].body.vertices, vertices,
-                                                      gradients.data());
+      backpropagateVertexGradients(pose, vertex_columns_[index], vertices, gradients.data());
   // One pass over the gradients, not two: dL/dt = sum_i g_i is not finite
   // whenever some g_i is not (inf and NaN never cancel back to a finite
   // value), so only a non-finite answer needs the scan that names the index.
