@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <exception>
+#include <filesystem>
 #include <sstream>
 
 #include "diff_rigid_body/exceptions.h"
@@ -50,7 +51,13 @@ std::string resolveMeshPath(const std::string& uri, const std::string& link_name
     }
     if (root.empty())
       throw MeshLoadError("link '" + link_name + "': mesh '" + uri + "': cannot find package '" + package + "'");
-    return root + (slash == std::string::npos ? "" : rest.substr(slash));
+    const std::string inside = slash == std::string::npos ? "" : rest.substr(slash);
+    // A package:// URI names a file inside the package: '..' may not leave it.
+    const std::filesystem::path normal = std::filesystem::path("." + inside).lexically_normal();
+    if (!normal.empty() && *normal.begin() == "..")
+      throw MeshLoadError("link '" + link_name + "': mesh '" + uri + "': the path leaves package '" + package +
+                          "' through '..'");
+    return root + inside;
   }
   if (uri.rfind(file_scheme, 0) == 0)
     return uri.substr(file_scheme.size());

@@ -5,8 +5,9 @@
 // robot descriptions use: assimp chooses its importer by extension first,
 // then by content), byte 1 the scale; the rest is the file. PLY is left out:
 // assimp 5.2's ASCII PLY reader loops forever on some malformed headers
-// (test/fuzz/findings/assimp_ply_ascii_hang.ply, docs/robustness.md). It is written to a private temporary file and
-// loaded from there, as a URDF's mesh would be.
+// (test/meshes/hostile/assimp_ply_ascii_hang.ply, docs/robustness.md). The
+// file is written to a private temporary file and loaded from there, as a
+// URDF's mesh would be.
 //
 // Passes when loading either throws a diff_rigid_body::Error (MeshLoadError
 // for what assimp or the checks refuse) or gives a mesh with finite
