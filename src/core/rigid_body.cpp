@@ -14,6 +14,42 @@ namespace diff_rigid_body
 {
 using detail::formatMatrix;
 
+namespace
+{
+/// The principal-moment part of checkMassProperties, for a finite tensor
+/// that is symmetric to kInertiaSymmetryTolerance.
+std::vector<std::string> checkPrincipalMoments(const std::string& where, const Eigen::Matrix3d& inertia)
+{
+  std::ostringstream why;
+  why.precision(17);
+  const Eigen::Matrix3d symmetric = 0.5 * (inertia + inertia.transpose());
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(symmetric, Eigen::EigenvaluesOnly);
+  const Eigen::Vector3d moments = solver.eigenvalues();  // ascending
+  const double eps = 16.0 * DBL_EPSILON * std::max(1.0, moments.cwiseAbs().sum() / 2.0);
+  if (!(moments[0] > 0.0))
+  {
+    why << where << ": inertia must be positive-definite, but its smallest principal moment is " << moments[0]
+        << " kg m^2 in " << formatMatrix(inertia);
+    if (moments[0] < -eps)  // a negative moment: no mass distribution has it
+      throw InvalidInertiaError(why.str());
+    return { why.str() };  // a zero moment: a point mass or a thin rod, M singular in rotation
+  }
+  if (moments[0] < DBL_MIN)
+  {
+    why << where << ": principal moments must be normal numbers (>= " << DBL_MIN
+        << " kg m^2), but the smallest is " << moments[0] << " kg m^2 in " << formatMatrix(inertia);
+    throw InvalidInertiaError(why.str());
+  }
+  if (moments[0] + moments[1] < moments[2] - eps)
+  {
+    why << where << ": principal moments break the triangle inequality I1 + I2 >= I3: " << moments[0] << " + "
+        << moments[1] << " < " << moments[2] << " kg m^2";
+    return { why.str() };
+  }
+  return {};
+}
+}  // namespace
+
 std::vector<std::string> checkMassProperties(const std::string& where, double mass, const Eigen::Matrix3d& inertia)
 {
   std::ostringstream why;
@@ -50,31 +86,7 @@ std::vector<std::string> checkMassProperties(const std::string& where, double ma
     why << where << ": inertia must be symmetric, but |I - I^T| = " << asymmetry << " in " << formatMatrix(inertia);
     throw InvalidInertiaError(why.str());
   }
-  const Eigen::Matrix3d symmetric = 0.5 * (inertia + inertia.transpose());
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(symmetric, Eigen::EigenvaluesOnly);
-  const Eigen::Vector3d moments = solver.eigenvalues();  // ascending
-  const double eps = 16.0 * DBL_EPSILON * std::max(1.0, moments.cwiseAbs().sum() / 2.0);
-  if (!(moments[0] > 0.0))
-  {
-    why << where << ": inertia must be positive-definite, but its smallest principal moment is " << moments[0]
-        << " kg m^2 in " << formatMatrix(inertia);
-    if (moments[0] < -eps)  // a negative moment: no mass distribution has it
-      throw InvalidInertiaError(why.str());
-    return { why.str() };  // a zero moment: a point mass or a thin rod, M singular in rotation
-  }
-  if (moments[0] < DBL_MIN)
-  {
-    why << where << ": principal moments must be normal numbers (>= " << DBL_MIN
-        << " kg m^2), but the smallest is " << moments[0] << " kg m^2 in " << formatMatrix(inertia);
-    throw InvalidInertiaError(why.str());
-  }
-  if (moments[0] + moments[1] < moments[2] - eps)
-  {
-    why << where << ": principal moments break the triangle inequality I1 + I2 >= I3: " << moments[0] << " + "
-        << moments[1] << " < " << moments[2] << " kg m^2";
-    return { why.str() };
-  }
-  return {};
+  return checkPrincipalMoments(where, inertia);
 }
 
 void validateMassProperties(const std::string& where, double mass, const Eigen::Matrix3d& inertia)

@@ -176,7 +176,7 @@ inline double laneSum(__m128d v)
 {
   return _mm_cvtsd_f64(_mm_add_sd(v, _mm_unpackhi_pd(v, v)));
 }
-__attribute__((target("avx2,fma"))) inline double laneSum(__m256d v)
+__attribute__((target("avx"))) inline double laneSum(__m256d v)
 {
   return laneSum(_mm_add_pd(_mm256_castpd256_pd128(v), _mm256_extractf128_pd(v, 1)));
 }
@@ -187,78 +187,47 @@ __attribute__((target("avx512f"))) inline double laneSum(__m512d v)
   return laneSum(_mm256_add_pd(_mm512_maskz_extractf64x4_pd(0xFF, v, 0), _mm512_maskz_extractf64x4_pd(0xFF, v, 1)));
 }
 
-/// Vertices [0, 8 floor(count / 8)), 8 per register; returns the vertices done.
-template <typename Vertices>
-__attribute__((target("avx512f"))) std::size_t addGradientSumsAvx512(const Vertices& vertices,
-                                                                     const ByVertex& gradients, std::size_t count,
-                                                                     GradientSums12& sums)
-{
-  // Fixed-count loops are unrolled (pragma) so that acc lives in registers.
-  __m512d acc[12];  // W row-major, then force
-#pragma GCC unroll 12
-  for (__m512d& a : acc)
-    a = _mm512_setzero_pd();
-  std::size_t n = 0;
-  for (; n + 8 <= count; n += 8)
-  {
-    if (n + kPrefetchVertices + 8 <= count)
-    {
-      gradients.prefetch(n + kPrefetchVertices);
-      vertices.prefetch(n + kPrefetchVertices);
-    }
-    __m512d G[3], P[3];
-    gradients.load8(n, G);
-    vertices.load8(n, P);
-#pragma GCC unroll 3
-    for (int a = 0; a < 3; ++a)
-    {
-#pragma GCC unroll 3
-      for (int b = 0; b < 3; ++b)
-        acc[3 * a + b] = _mm512_fmadd_pd(G[a], P[b], acc[3 * a + b]);
-      acc[9 + a] = _mm512_add_pd(acc[9 + a], G[a]);
-    }
+/// The wide kernels: vertices [0, W floor(count / W)), W per register (8
+/// for AVX-512F, 4 for AVX2 + FMA), one FMA per product, the lanes added by
+/// laneSum at the end; returns the vertices done. One body for both widths:
+/// GCC compiles a function for one target only and refuses to inline
+/// target-specific code into a template without that target, so the body is
+/// a macro instantiated once per target. The prefetch is issued once per
+/// 8 vertices (one line of each coordinate array).
+#define DRB_GRADIENT_SUMS_KERNEL(NAME, TARGET, REG, WIDTH, SETZERO, FMADD, ADD, LOAD)                               \
+  template <typename Vertices>                                                                                    \
+  __attribute__((target(TARGET))) std::size_t NAME(const Vertices& vertices, const ByVertex& gradients,           \
+                                                   std::size_t count, GradientSums12& sums)                       \
+  {                                                                                                               \
+    REG acc[12]; /* W row-major, then force */                                                                    \
+    _Pragma("GCC unroll 12") for (REG& a : acc) a = SETZERO();                                                    \
+    std::size_t n = 0;                                                                                            \
+    for (; n + WIDTH <= count; n += WIDTH)                                                                        \
+    {                                                                                                             \
+      if (n % 8 == 0 && n + kPrefetchVertices + 8 <= count)                                                       \
+      {                                                                                                           \
+        gradients.prefetch(n + kPrefetchVertices);                                                                \
+        vertices.prefetch(n + kPrefetchVertices);                                                                 \
+      }                                                                                                           \
+      REG G[3], P[3];                                                                                             \
+      gradients.LOAD(n, G);                                                                                       \
+      vertices.LOAD(n, P);                                                                                        \
+      /* Fixed-count loops are unrolled so that acc lives in registers. */                                        \
+      _Pragma("GCC unroll 3") for (int a = 0; a < 3; ++a)                                                         \
+      {                                                                                                           \
+        _Pragma("GCC unroll 3") for (int b = 0; b < 3; ++b) acc[3 * a + b] = FMADD(G[a], P[b], acc[3 * a + b]);   \
+        acc[9 + a] = ADD(acc[9 + a], G[a]);                                                                       \
+      }                                                                                                           \
+    }                                                                                                             \
+    _Pragma("GCC unroll 12") for (int k = 0; k < 12; ++k) sums[k] += laneSum(acc[k]);                             \
+    return n;                                                                                                     \
   }
-#pragma GCC unroll 12
-  for (int k = 0; k < 12; ++k)
-    sums[k] += laneSum(acc[k]);
-  return n;
-}
 
-/// Vertices [0, 4 floor(count / 4)), 4 per register; returns the vertices done.
-template <typename Vertices>
-__attribute__((target("avx2,fma"))) std::size_t addGradientSumsAvx2(const Vertices& vertices,
-                                                                   const ByVertex& gradients, std::size_t count,
-                                                                   GradientSums12& sums)
-{
-  __m256d acc[12];  // W row-major, then force
-#pragma GCC unroll 12
-  for (__m256d& a : acc)
-    a = _mm256_setzero_pd();
-  std::size_t n = 0;
-  for (; n + 4 <= count; n += 4)
-  {
-    if (n % 8 == 0 && n + kPrefetchVertices + 8 <= count)  // once per line of each array
-    {
-      gradients.prefetch(n + kPrefetchVertices);
-      vertices.prefetch(n + kPrefetchVertices);
-    }
-    __m256d G[3], P[3];
-    gradients.load4(n, G);
-    vertices.load4(n, P);
-#pragma GCC unroll 3
-    for (int a = 0; a < 3; ++a)
-    {
-#pragma GCC unroll 3
-      for (int b = 0; b < 3; ++b)
-        acc[3 * a + b] = _mm256_fmadd_pd(G[a], P[b], acc[3 * a + b]);
-      acc[9 + a] = _mm256_add_pd(acc[9 + a], G[a]);
-    }
-  }
-#pragma GCC unroll 12
-  for (int k = 0; k < 12; ++k)
-    sums[k] += laneSum(acc[k]);
-  return n;
-}
+DRB_GRADIENT_SUMS_KERNEL(addGradientSumsAvx512, "avx512f", __m512d, 8, _mm512_setzero_pd, _mm512_fmadd_pd,
+                         _mm512_add_pd, load8)
+DRB_GRADIENT_SUMS_KERNEL(addGradientSumsAvx2, "avx2,fma", __m256d, 4, _mm256_setzero_pd, _mm256_fmadd_pd,
+                         _mm256_add_pd, load4)
+#undef DRB_GRADIENT_SUMS_KERNEL
 #endif
 
 /// The 12 sums over vertices [0, count): the widest path the CPU has, then
