@@ -21,6 +21,7 @@
 #include <mpreal.h>
 
 #include "bench_common.h"
+#include "memory_floors.h"
 #include "methods.h"
 
 namespace
@@ -146,6 +147,9 @@ int main(int argc, char** argv)
       oursMassMatrix(s.q, b.mass, b.inertia, M);
       record(mass_table, "ours_double", tag, massMatrixError(M, ref));
       record(mass_table, "ours_batch_double", tag, massMatrixError(batch.data() + 36 * k, ref));
+      // The node's single request: massMatrixBatch of one state.
+      drb::massMatrixBatch(s.q.data(), 1, 6, b.mass, b.inertia, M);
+      record(mass_table, "ours_batch_single", tag, massMatrixError(M, ref));
       const drb::Matrix6<float> Mf = drb::massMatrix(drb::Vector6<float>(s.q.cast<float>()),
                                                      static_cast<float>(b.mass), I_f);
       const Matrix6d Mfd = Mf.cast<double>();
@@ -268,6 +272,9 @@ int main(int argc, char** argv)
     const drb::Matrix3X<mpreal> vertices_mp = vertices.cast<mpreal>();
     std::vector<mpreal> g_mp(g.begin(), g.end());
     const drb::VertexColumns<double> columns = vertices.transpose();
+    std::vector<std::uint32_t> all_indices(nv);
+    for (std::size_t v = 0; v < nv; ++v)
+      all_indices[v] = static_cast<std::uint32_t>(v);
     for (const TaggedState& s : states)
     {
       const drb::BodyPose<mpreal> pose_mp(VectorMp6(s.q.cast<mpreal>()));
@@ -281,6 +288,12 @@ int main(int argc, char** argv)
       const drb::BodyPose<double> pose(s.q);
       check("ours_double", drb::backpropagateVertexGradients(pose, vertices, {}, g.data()));
       check("ours_columns", drb::backpropagateVertexGradients(pose, columns, g.data()));
+      check("ours_index_list", drb::backpropagateVertexGradients(pose, columns, all_indices, g.data()));
+#if defined(DRB_BENCH_SIMD_PATHS)
+      for (SimdPath path : { SimdPath::sse2, SimdPath::avx2, SimdPath::avx512 })
+        if (cpuHas(path))
+          check(std::string("columns_on_") + pathName(path), backpropColumnsOnPath(path, pose, columns, g.data()));
+#endif
       check("form_J_and_multiply", backpropFormJ(pose, vertices, g.data()));
       check("J_buffer_then_multiply", backpropViaBuffer(pose, vertices, g.data(), buffer.data()));
     }
