@@ -1,5 +1,6 @@
-// Independent kinematics oracles (Eigen only, no library header), shared by
-// the unit tests, the rostests and (possibly) the benchmarks.
+// Independent kinematics oracles (Eigen only; of the library, only its type
+// aliases), shared by the unit tests, the rostests and (possibly) the
+// benchmarks.
 //
 // Everything here is written from docs/derivation.md, NOT from the headers
 // under test: rotations are products of elementary rotations, dR is the long
@@ -19,16 +20,15 @@
 
 #include <Eigen/Core>
 
+#include "diff_rigid_body/types.h"  // Eigen aliases only: no library code
+
 namespace drb_test
 {
-using Eigen::Matrix3;
-using Eigen::Vector3;
-template <typename S>
-using Vector6 = Eigen::Matrix<S, 6, 1>;
-template <typename S>
-using Matrix6 = Eigen::Matrix<S, 6, 6>;
-template <typename S>
-using Matrix36 = Eigen::Matrix<S, 3, 6>;
+using diff_rigid_body::Matrix3;
+using diff_rigid_body::Matrix36;
+using diff_rigid_body::Matrix6;
+using diff_rigid_body::Vector3;
+using diff_rigid_body::Vector6;
 
 // ---------------------------------------------------------------------------
 // Elementary rotations and their derivatives (right-handed, active).

@@ -29,6 +29,7 @@
 #include "diff_rigid_body/mass_properties.h"
 #include "reference/particle_mass_properties.h"
 #include "../support/expect_throws.h"
+#include "../support/meshes.h"
 
 using diff_rigid_body::boxMassProperties;
 using diff_rigid_body::combineMassProperties;
@@ -44,6 +45,8 @@ using diff_rigid_body::particleMassProperties;
 using diff_rigid_body::sphereMassProperties;
 using diff_rigid_body::transformMassProperties;
 using diff_rigid_body::TriangleMesh;
+using drb_test::makeMesh;
+using drb_test::readObj;
 
 namespace
 {
@@ -97,16 +100,6 @@ Eigen::Isometry3d randomPose(std::mt19937& rng, double translation_scale)
   pose.linear() = q.toRotationMatrix();
   pose.translation() = translation_scale * Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng));
   return pose;
-}
-
-TriangleMesh makeMesh(const std::vector<Eigen::Vector3d>& vertices, const std::vector<std::array<std::uint32_t, 3>>& tris)
-{
-  TriangleMesh mesh;
-  mesh.vertices.resize(3, static_cast<Eigen::Index>(vertices.size()));
-  for (std::size_t i = 0; i < vertices.size(); ++i)
-    mesh.vertices.col(static_cast<Eigen::Index>(i)) = vertices[i];
-  mesh.triangles = tris;
-  return mesh;
 }
 
 /// Axis-aligned box centred at the origin, 8 vertices, 12 outward triangles.
@@ -203,51 +196,6 @@ TriangleMesh prismMesh(int n, double r, double l)
     f.push_back({ i, N + j, N + i });
   }
   return makeMesh(v, f);
-}
-
-/// Minimal OBJ reader: `v x y z` and `f a b c ...` (a, a/b, a//c, a/b/c, negative = relative), fans polygons.
-bool readObj(const std::string& path, TriangleMesh* mesh, std::string* error)
-{
-  std::ifstream in(path);
-  if (!in)
-  {
-    *error = "cannot open " + path;
-    return false;
-  }
-  std::vector<Eigen::Vector3d> v;
-  std::vector<std::array<std::uint32_t, 3>> f;
-  std::string line;
-  while (std::getline(in, line))
-  {
-    std::istringstream tokens(line);
-    std::string tag;
-    tokens >> tag;
-    if (tag == "v")
-    {
-      Eigen::Vector3d p;
-      tokens >> p.x() >> p.y() >> p.z();
-      v.push_back(p);
-    }
-    else if (tag == "f")
-    {
-      std::vector<std::uint32_t> polygon;
-      std::string corner;
-      while (tokens >> corner)
-      {
-        const long index = std::stol(corner.substr(0, corner.find('/')));
-        polygon.push_back(static_cast<std::uint32_t>(index > 0 ? index - 1 : static_cast<long>(v.size()) + index));
-      }
-      for (std::size_t k = 2; k < polygon.size(); ++k)
-        f.push_back({ polygon[0], polygon[k - 1], polygon[k] });
-    }
-  }
-  if (v.empty() || f.empty())
-  {
-    *error = path + " has no vertices or faces";
-    return false;
-  }
-  *mesh = makeMesh(v, f);
-  return true;
 }
 
 /// Volume of a polyhedron star-shaped about the origin, as pyramids: sum area_f * height_f / 3.

@@ -118,34 +118,30 @@ TEST(StateFile, RefusesDamagedFiles)
   DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(bad_end, scene), drb::StateFileError,
                             "expected 'end <count> crc32 <8 hex digits>'");
   // Correct checksums over wrong contents.
-  std::string body = withoutTrailer(good);
+  const std::string body = withoutTrailer(good);
   DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(reseal(body, 3), scene), drb::StateFileError, "body count mismatch");
-  std::string count = body;
-  count.replace(count.find("bodies 2"), 8, "bodies 3");
+  const std::string count = drb_test::replacedOnce(body, "bodies 2", "bodies 3");
   DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(reseal(count, 3), scene), drb::StateFileError,
                             "body count mismatch: 'bodies 3', 2 body lines");
-  std::string nan_line = body.substr(0, body.find("body cube")) + "body cube nan 0x0p+0 0x0p+0 0x0p+0 0x0p+0 0x0p+0\n" +
-                         body.substr(body.find("body ball"));
-  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(reseal(nan_line, 2), scene), drb::StateFileError,
-                            "q[0] of body 'cube': not a hex float: 'nan'");
-  std::string inf_line = body.substr(0, body.find("body cube")) +
-                         "body cube 0x0p+0 0xinf 0x0p+0 0x0p+0 0x0p+0 0x0p+0\n" + body.substr(body.find("body ball"));
-  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(reseal(inf_line, 2), scene), drb::StateFileError,
-                            "q[1] of body 'cube': not finite");
-  std::string decimal = body.substr(0, body.find("body cube")) + "body cube 0.5 0x0p+0 0x0p+0 0x0p+0 0x0p+0 0x0p+0\n" +
-                        body.substr(body.find("body ball"));
-  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(reseal(decimal, 2), scene), drb::StateFileError,
-                            "q[0] of body 'cube': not a hex float: '0.5'");
-  std::string short_line = body.substr(0, body.find("body cube")) + "body cube 0x0p+0 0x0p+0\n" +
-                           body.substr(body.find("body ball"));
-  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(reseal(short_line, 2), scene), drb::StateFileError,
+  // The cube's body line replaced by `line`, resealed.
+  const auto with_cube_line = [&](const std::string& line) {
+    return reseal(body.substr(0, body.find("body cube")) + line + "\n" + body.substr(body.find("body ball")), 2);
+  };
+  DRB_EXPECT_THROWS_MESSAGE(
+      drb::parseStateFile(with_cube_line("body cube nan 0x0p+0 0x0p+0 0x0p+0 0x0p+0 0x0p+0"), scene),
+      drb::StateFileError, "q[0] of body 'cube': not a hex float: 'nan'");
+  DRB_EXPECT_THROWS_MESSAGE(
+      drb::parseStateFile(with_cube_line("body cube 0x0p+0 0xinf 0x0p+0 0x0p+0 0x0p+0 0x0p+0"), scene),
+      drb::StateFileError, "q[1] of body 'cube': not finite");
+  DRB_EXPECT_THROWS_MESSAGE(
+      drb::parseStateFile(with_cube_line("body cube 0.5 0x0p+0 0x0p+0 0x0p+0 0x0p+0 0x0p+0"), scene),
+      drb::StateFileError, "q[0] of body 'cube': not a hex float: '0.5'");
+  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(with_cube_line("body cube 0x0p+0 0x0p+0"), scene), drb::StateFileError,
                             "line 4: expected 'body <name> <6 hex floats>'");
-  std::string bad_name = body.substr(0, body.find("body cube")) +
-                         "body cu%4 0x0p+0 0x0p+0 0x0p+0 0x0p+0 0x0p+0 0x0p+0\n" + body.substr(body.find("body ball"));
-  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(reseal(bad_name, 2), scene), drb::StateFileError,
-                            "line 4: malformed body name 'cu%4'");
-  std::string crlf = body;
-  crlf.replace(crlf.find("bodies 2\n"), 9, "bodies 2\r\n");
+  DRB_EXPECT_THROWS_MESSAGE(
+      drb::parseStateFile(with_cube_line("body cu%4 0x0p+0 0x0p+0 0x0p+0 0x0p+0 0x0p+0 0x0p+0"), scene),
+      drb::StateFileError, "line 4: malformed body name 'cu%4'");
+  const std::string crlf = drb_test::replacedOnce(body, "bodies 2\n", "bodies 2\r\n");
   DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(reseal(crlf, 2), scene), drb::StateFileError,
                             "line 3: expected 'bodies <count>'");
   DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(std::string(drb::maxStateFileSize(2) + 1, '\n'), scene),

@@ -55,13 +55,10 @@ TEST(UrdfScene, MergesFixedLinksTransitivelyWithParallelAxisInertia)
   // base (1 kg at its origin) + arm (1 kg, 1 m along x) + massless tip:
   //   mass 2 kg, COM (0.5, 0, 0);
   //   I = 2 * diag(0.1) + 2 * 1 kg * diag(0, 0.25, 0.25) = diag(0.2, 0.7, 0.7).
-  const std::string xml =
-      robot("<link name=\"base\">" + inertial() + "</link><link name=\"arm\">" + inertial() +
-            "</link><link name=\"tip\"/>" + floatingJoint("base", "<origin xyz=\"0 0 1\" rpy=\"0 0 0.5\"/>") +
-            "<joint name=\"j_arm\" type=\"fixed\"><parent link=\"base\"/><child link=\"arm\"/>"
-            "<origin xyz=\"1 0 0\"/></joint>"
-            "<joint name=\"j_tip\" type=\"fixed\"><parent link=\"arm\"/><child link=\"tip\"/>"
-            "<origin xyz=\"0 1 0\" rpy=\"0.3 0 0\"/></joint>");
+  const std::string xml = robot(link("base", inertial()) + link("arm", inertial()) + link("tip") +
+                                floatingJoint("base", "<origin xyz=\"0 0 1\" rpy=\"0 0 0.5\"/>") +
+                                joint("fixed", "base", "arm", "<origin xyz=\"1 0 0\"/>") +
+                                joint("fixed", "arm", "tip", "<origin xyz=\"0 1 0\" rpy=\"0.3 0 0\"/>"));
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
   ASSERT_EQ(scene.bodies.size(), 1u);
   const drb::SceneBody& body = scene.bodies[0];
@@ -84,19 +81,13 @@ TEST(UrdfScene, MergesFixedLinksTransitivelyWithParallelAxisInertia)
 
 TEST(UrdfScene, StaticLinksAndUnmodelledJoints)
 {
-  const std::string xml = robot("<link name=\"table\"><collision><geometry><box size=\"1 1 "
-                                "1\"/></geometry></collision></link>"
-                                "<link name=\"box\">" +
-                                inertial() + "</link><link name=\"flap\">" + inertial() +
-                                "</link>"
-                                "<joint name=\"j_table\" type=\"fixed\"><parent link=\"world\"/><child link=\"table\"/>"
-                                "<origin xyz=\"0 0 0.5\"/></joint>" +
-                                "<joint name=\"j_box\" type=\"floating\"><parent link=\"table\"/><child link=\"box\"/>"
-                                "<origin xyz=\"0 0 1\"/></joint>"
-                                "<joint name=\"hinge\" type=\"revolute\"><parent link=\"box\"/><child link=\"flap\"/>"
-                                "<origin xyz=\"0 0 0.25\"/><axis xyz=\"1 0 0\"/><limit lower=\"-1\" upper=\"1\" "
-                                "effort=\"1\" "
-                                "velocity=\"1\"/></joint>");
+  const std::string xml =
+      robot(link("table", collision(boxGeometry("1 1 1"))) + link("box", inertial()) + link("flap", inertial()) +
+            joint("fixed", "world", "table", "<origin xyz=\"0 0 0.5\"/>") +
+            floatingJoint("box", "<origin xyz=\"0 0 1\"/>", "table") +
+            "<joint name=\"hinge\" type=\"revolute\"><parent link=\"box\"/><child link=\"flap\"/>"
+            "<origin xyz=\"0 0 0.25\"/><axis xyz=\"1 0 0\"/>"
+            "<limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1\"/></joint>");
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
   ASSERT_EQ(scene.static_links.size(), 1u);
   EXPECT_EQ(scene.static_links[0].name, "table");
@@ -132,19 +123,9 @@ TEST(UrdfScene, MeshScaleAndOriginFromAFile)
   // -> (0,0,0), (2,0,0), (0,3,0), (0,0,4); yaw pi/2 maps (x, y, z) to (-y, x, z)
   // -> (0,0,0), (0,2,0), (-3,0,0), (0,0,4); then + (0.5, 0, 0). Mesh order is
   // the order of first use by the faces (first face: 1 3 2).
-  const std::string xml = robot(
-      link("tet", inertial() + collision(meshGeometry("file://" + kTestMeshDir + "/tetrahedron.obj", "2 3 4"), "<origin"
-                                                                                                               " xyz="
-                                                                                                               "\"0.5 "
-                                                                                                               "0 0\" "
-                                                                                                               "rpy="
-                                                                                                               "\"0 0 "
-                                                                                                               "1."
-                                                                                                               "5707963"
-                                                                                                               "2679489"
-                                                                                                               "66\"/"
-                                                                                                               ">")) +
-      floatingJoint("tet"));
+  const std::string origin = "<origin xyz=\"0.5 0 0\" rpy=\"0 0 1.5707963267948966\"/>";
+  const std::string mesh = meshGeometry("file://" + kTestMeshDir + "/tetrahedron.obj", "2 3 4");
+  const std::string xml = robot(link("tet", inertial() + collision(mesh, origin)) + floatingJoint("tet"));
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
   const Eigen::Matrix3Xd& v = scene.bodies[0].body.vertices;
   ASSERT_EQ(v.cols(), 4);
@@ -201,9 +182,9 @@ TEST(UrdfScene, RejectsUnusableDescriptions)
   DRB_EXPECT_THROWS_MESSAGE(drb::loadSceneFromUrdf(robot("")), drb::SceneDescriptionError, "no body");
   DRB_EXPECT_THROWS_MESSAGE(drb::loadSceneFromUrdf(oneBody(inertial("-1"))), drb::InvalidInertiaError,
                             "link 'b' <inertial>: mass must be > 0");
-  DRB_EXPECT_THROWS_MESSAGE(drb::loadSceneFromUrdf(oneBody(inertial() + collision(meshGeometry("/nonexistent/"
-                                                                                               "missing.stl")))),
-                            drb::MeshLoadError, "/nonexistent/missing.stl");
+  const std::string missing_mesh = collision(meshGeometry("/nonexistent/missing.stl"));
+  DRB_EXPECT_THROWS_MESSAGE(drb::loadSceneFromUrdf(oneBody(inertial() + missing_mesh)), drb::MeshLoadError,
+                            "/nonexistent/missing.stl");
   DRB_EXPECT_THROWS_MESSAGE(drb::loadSceneFromUrdf(oneBody(inertial() + collision(boxGeometry("1 0 1")))),
                             drb::SceneDescriptionError, "box size y must be finite and > 0");
   drb::SceneOptions unknown;
