@@ -3,11 +3,10 @@
 // evaluated on it.
 //
 // Everything here is written from the URDF numbers and from docs/derivation.md:
-//   - rotations are products of Eigen::AngleAxisd (R = Rz(psi) Ry(theta) Rx(phi));
-//   - T(r) is assembled column by column from the rotation axes
-//     (omega = psidot e_z + thetadot Rz e_y + phidot Rz Ry e_x);
-//   - M = blockdiag(T^T R I_b R^T T, m I3) (not the library's A^T I_b A);
-//   - J = [-[R p0]_x T, I3];
+//   - rotations, T(r), M, J and dL/dq from test/support/kinematics_oracles.h
+//     (R = Rz(psi) Ry(theta) Rx(phi) from elementary rotations; T column by
+//     column from the rotation axes; M = blockdiag(T^T R I_b R^T T, m I3),
+//     not the library's A^T I_b A; J = [-[R p0]_x T, I3]);
 //   - composite mass properties by the parallel-axis theorem;
 //   - primitive tessellations from the documented resolution
 //     (mesh_loader.h: box corners x fastest, UV sphere 8 rings x 16
@@ -24,6 +23,8 @@
 
 #include <Eigen/Geometry>
 
+#include "../support/kinematics_oracles.h"
+
 namespace drb_rostest
 {
 constexpr double kPi = 3.14159265358979323846;
@@ -32,87 +33,22 @@ using Matrix36d = Eigen::Matrix<double, 3, 6>;
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 
 // ---------------------------------------------------------------------------
-// docs/derivation.md, written out.
-
-/// R = Rz(psi) Ry(theta) Rx(phi), the URDF rpy and tf2 setRPY convention.
-inline Eigen::Matrix3d rpyRotation(double phi, double theta, double psi)
-{
-  return (Eigen::AngleAxisd(psi, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(theta, Eigen::Vector3d::UnitY()) *
-          Eigen::AngleAxisd(phi, Eigen::Vector3d::UnitX()))
-      .toRotationMatrix();
-}
-
-/// T(r): world angular velocity omega = T rdot. Column j is the world axis
-/// of the rotation by q_j: e_x after Rz Ry, e_y after Rz, e_z.
-inline Eigen::Matrix3d angularVelocityMap(double /*phi*/, double theta, double psi)
-{
-  const Eigen::Matrix3d Rz = Eigen::AngleAxisd(psi, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  const Eigen::Matrix3d Ry = Eigen::AngleAxisd(theta, Eigen::Vector3d::UnitY()).toRotationMatrix();
-  Eigen::Matrix3d T;
-  T.col(0) = Rz * Ry * Eigen::Vector3d::UnitX();
-  T.col(1) = Rz * Eigen::Vector3d::UnitY();
-  T.col(2) = Eigen::Vector3d::UnitZ();
-  return T;
-}
-
-inline Eigen::Matrix3d skew(const Eigen::Vector3d& v)
-{
-  Eigen::Matrix3d S;
-  S << 0, -v.z(), v.y(),  //
-      v.z(), 0, -v.x(),   //
-      -v.y(), v.x(), 0;
-  return S;
-}
-
-/// M(q) = blockdiag(T^T R I_b R^T T, m I3), with I' = R I_b R^T formed explicitly.
-/// \param mass  [kg]   \param inertia_body  I_b about the COM, body axes [kg m^2]
-inline Matrix6d massMatrixOracle(const Vector6d& q, double mass, const Eigen::Matrix3d& inertia_body)
-{
-  const Eigen::Matrix3d R = rpyRotation(q[0], q[1], q[2]);
-  const Eigen::Matrix3d T = angularVelocityMap(q[0], q[1], q[2]);
-  Matrix6d M = Matrix6d::Zero();
-  M.topLeftCorner<3, 3>() = T.transpose() * (R * inertia_body * R.transpose()) * T;
-  M.bottomRightCorner<3, 3>() = mass * Eigen::Matrix3d::Identity();
-  return M;
-}
-
-/// p = R p0 + t [m].
-inline Eigen::Vector3d vertexPositionOracle(const Vector6d& q, const Eigen::Vector3d& p0)
-{
-  return rpyRotation(q[0], q[1], q[2]) * p0 + q.tail<3>();
-}
-
-/// J = dp/dq = [-[R p0]_x T, I3] (3x6, columns in q order).
-inline Matrix36d vertexJacobianOracle(const Vector6d& q, const Eigen::Vector3d& p0)
-{
-  Matrix36d J;
-  J.leftCols<3>() = -skew(rpyRotation(q[0], q[1], q[2]) * p0) * angularVelocityMap(q[0], q[1], q[2]);
-  J.rightCols<3>() = Eigen::Matrix3d::Identity();
-  return J;
-}
-
-/// dL/dq = (T^T sum_i (R p0_i) x g_i, sum_i g_i).
-inline Vector6d backpropOracle(const Vector6d& q, const std::vector<Eigen::Vector3d>& p0,
-                               const std::vector<Eigen::Vector3d>& g)
-{
-  const Eigen::Matrix3d R = rpyRotation(q[0], q[1], q[2]);
-  Eigen::Vector3d torque = Eigen::Vector3d::Zero(), force = Eigen::Vector3d::Zero();
-  for (std::size_t i = 0; i < p0.size(); ++i)
-  {
-    torque += (R * p0[i]).cross(g[i]);
-    force += g[i];
-  }
-  Vector6d out;
-  out.head<3>() = angularVelocityMap(q[0], q[1], q[2]).transpose() * torque;
-  out.tail<3>() = force;
-  return out;
-}
+// docs/derivation.md, written out (test/support/kinematics_oracles.h):
+// R = Rz(psi) Ry(theta) Rx(phi) from elementary rotations, T(r) column by
+// column from the rotation axes, M = blockdiag(T^T R I_b R^T T, m I3),
+// p = R p0 + t, J = [-[R p0]_x T, I3], dL/dq = (T^T sum (R p0_i) x g_i, sum g_i).
+using drb_test::refAngularVelocityMatrix;
+using drb_test::refBackprop;
+using drb_test::refJacobianFromAngularVelocity;
+using drb_test::refMassMatrix;
+using drb_test::refPosition;
+using drb_test::refRotation;
 
 /// A URDF <origin xyz rpy>.
 inline Eigen::Isometry3d urdfPose(const Eigen::Vector3d& xyz, const Eigen::Vector3d& rpy = Eigen::Vector3d::Zero())
 {
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  X.linear() = rpyRotation(rpy.x(), rpy.y(), rpy.z());
+  X.linear() = refRotation(rpy.x(), rpy.y(), rpy.z());
   X.translation() = xyz;
   return X;
 }
@@ -196,7 +132,7 @@ inline FixtureInertial urdfInertial(double mass, const Eigen::Vector3d& xyz, con
 {
   Eigen::Matrix3d I;
   I << ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz;
-  const Eigen::Matrix3d Ro = rpyRotation(rpy.x(), rpy.y(), rpy.z());
+  const Eigen::Matrix3d Ro = refRotation(rpy.x(), rpy.y(), rpy.z());
   return { mass, xyz, Ro * I * Ro.transpose() };
 }
 

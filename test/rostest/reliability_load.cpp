@@ -1,7 +1,7 @@
 // Load test of rigid_body_server (reliability_load.test): 8 concurrent
 // clients for ~duration seconds, each mixing set_state, get_state,
-// get_mass_matrix, get_vertex_jacobians and backprop over its own persistent
-// connections.
+// get_mass_matrix, get_vertex_jacobians and backprop through its own
+// RigidBodyClient (the shipped C++ client: persistent connections).
 //
 // Every writer w writes, at its sequence number s, the full state
 //   q(w, s, b) = (0.1 (w+1) + 0.01 b, 0.05 (w+1) + 0.001 b, 0.1 (w+1), w + 1, s, b)
@@ -39,14 +39,11 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
-#include <diff_rigid_body/Backprop.h>
-#include <diff_rigid_body/GetBodies.h>
-#include <diff_rigid_body/GetMassMatrix.h>
-#include <diff_rigid_body/GetState.h>
-#include <diff_rigid_body/GetVertexJacobians.h>
-#include <diff_rigid_body/SetState.h>
+#include <diff_rigid_body_ros/rigid_body_client.h>
 
-namespace drb = diff_rigid_body;
+#include "../support/kinematics_oracles.h"
+
+using diff_rigid_body_ros::RigidBodyClient;
 
 namespace
 {
@@ -57,6 +54,7 @@ constexpr double kGradientTolerance = 1e-9;   // relative to max(1, |dL/dq|)
 constexpr double kCosTolerance = 1e-12;
 
 using Vector6d = Eigen::Matrix<double, 6, 1>;
+const char* const kServer = "/rigid_body_server";
 const char* const kServices[] = { "set_state", "get_state", "get_mass_matrix", "get_vertex_jacobians", "backprop" };
 constexpr int kServiceCount = 5;
 
@@ -66,25 +64,6 @@ Vector6d writtenQ(int w, long s, std::size_t b)
   q << 0.1 * (w + 1) + 0.01 * b, 0.05 * (w + 1) + 0.001 * b, 0.1 * (w + 1), w + 1.0, static_cast<double>(s),
       static_cast<double>(b);
   return q;
-}
-
-Eigen::Matrix3d rotation(const Vector6d& q)
-{
-  return (Eigen::AngleAxisd(q[2], Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(q[1], Eigen::Vector3d::UnitY()) *
-          Eigen::AngleAxisd(q[0], Eigen::Vector3d::UnitX()))
-      .toRotationMatrix();
-}
-
-// T(r): omega = T rdot; columns Rz Ry e_x, Rz e_y, e_z.
-Eigen::Matrix3d angularVelocityMap(const Vector6d& q)
-{
-  const Eigen::Matrix3d Rz = Eigen::AngleAxisd(q[2], Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  const Eigen::Matrix3d Ry = Eigen::AngleAxisd(q[1], Eigen::Vector3d::UnitY()).toRotationMatrix();
-  Eigen::Matrix3d T;
-  T.col(0) = Rz * Ry * Eigen::Vector3d::UnitX();
-  T.col(1) = Rz * Eigen::Vector3d::UnitY();
-  T.col(2) = Eigen::Vector3d::UnitZ();
-  return T;
 }
 
 double percentile(std::vector<double> values, double p)
@@ -102,7 +81,8 @@ struct SceneFacts
   std::vector<std::string> names;
   std::vector<Vector6d> initial;      // URDF initial state per body
   std::vector<Eigen::Vector3d> p0;    // body 0's vertices in its body frame
-  std::vector<double> gradients;      // dL/dp for backprop on body 0
+  std::vector<Eigen::Vector3d> g;     // dL/dp for backprop on body 0, per vertex
+  Eigen::Matrix3Xd gradients;         // the same, column i for vertex i
 };
 
 // One (writer, sequence) a reader saw.
@@ -124,16 +104,9 @@ struct ClientResult
 class Client
 {
 public:
-  Client(int id, const SceneFacts& facts, std::atomic<bool>& stop) : id_(id), facts_(facts), stop_(stop)
-  {
-    ros::NodeHandle nh;
-    const std::string server = "/rigid_body_server/";
-    set_state_ = nh.serviceClient<drb::SetState>(server + "set_state", true);
-    get_state_ = nh.serviceClient<drb::GetState>(server + "get_state", true);
-    get_mass_matrix_ = nh.serviceClient<drb::GetMassMatrix>(server + "get_mass_matrix", true);
-    get_vertex_jacobians_ = nh.serviceClient<drb::GetVertexJacobians>(server + "get_vertex_jacobians", true);
-    backprop_ = nh.serviceClient<drb::Backprop>(server + "backprop", true);
-  }
+  Client(int id, const SceneFacts& facts, std::atomic<bool>& stop)
+    : id_(id), facts_(facts), stop_(stop), client_(ros::NodeHandle(), kServer, ros::Duration(60.0))
+  {}
 
   void run()
   {
@@ -170,20 +143,25 @@ public:
   ClientResult result;
 
 private:
-  template <typename Service>
-  bool call(ros::ServiceClient& client, Service& service, const char* name)
+  /// Runs one call of the client; a refusal (success=false) or a transport
+  /// failure is recorded as a failure.
+  template <typename Call>
+  bool call(const char* name, Call&& call)
   {
-    if (!client.call(service))
+    try
     {
-      result.failures.push_back(std::string(name) + ": transport failure");
-      return false;
+      call();
+      return true;
     }
-    if (!service.response.success)
+    catch (const diff_rigid_body_ros::ServiceError& e)
     {
-      result.failures.push_back(std::string(name) + ": success=false: " + service.response.message);
-      return false;
+      result.failures.push_back(std::string(name) + ": success=false: " + e.message());
     }
-    return true;
+    catch (const diff_rigid_body_ros::ConnectionError& e)
+    {
+      result.failures.push_back(std::string(name) + ": transport failure: " + e.what());
+    }
+    return false;
   }
 
   void torn(const std::string& what) { result.torn.push_back("client " + std::to_string(id_) + ": " + what); }
@@ -196,16 +174,10 @@ private:
 
   bool setState()
   {
-    drb::SetState service;
+    std::vector<std::pair<std::string, Vector6d>> states;
     for (std::size_t b = 0; b < facts_.names.size(); ++b)
-    {
-      drb::BodyState state;
-      state.name = facts_.names[b];
-      const Vector6d q = writtenQ(id_, sequence_, b);
-      std::copy(q.data(), q.data() + 6, state.q.begin());
-      service.request.states.push_back(state);
-    }
-    if (!call(set_state_, service, "set_state"))
+      states.emplace_back(facts_.names[b], writtenQ(id_, sequence_, b));
+    if (!call("set_state", [&] { client_.setState(states); }))
       return false;
     result.acked.insert(sequence_++);
     return true;
@@ -213,17 +185,16 @@ private:
 
   bool getState()
   {
-    drb::GetState service;
-    if (!call(get_state_, service, "get_state"))
+    std::vector<std::pair<std::string, Vector6d>> states;
+    if (!call("get_state", [&] { states = client_.getState(); }))
       return false;
-    const auto& states = service.response.states;
     if (states.size() != facts_.names.size())
     {
       torn("get_state: " + std::to_string(states.size()) + " states");
       return true;
     }
     // Body 0 names the write; which is it?
-    const Vector6d q0 = Eigen::Map<const Vector6d>(states[0].q.data());
+    const Vector6d& q0 = states[0].second;
     int w = kInitial;
     long s = 0;
     if (std::memcmp(q0.data(), facts_.initial[0].data(), sizeof(double) * 6) != 0)
@@ -239,12 +210,13 @@ private:
     for (std::size_t b = 0; b < states.size(); ++b)
     {
       const Vector6d expected = candidate(w, s, b);
-      if (states[b].name != facts_.names[b] || std::memcmp(states[b].q.data(), expected.data(), sizeof(double) * 6))
+      if (states[b].first != facts_.names[b] ||
+          std::memcmp(states[b].second.data(), expected.data(), sizeof(double) * 6))
       {
         std::ostringstream why;
         why.precision(17);
-        why << "get_state: body " << b << " (" << states[b].name << ") is not part of write (" << w << ", " << s
-            << "): q = [" << Eigen::Map<const Vector6d>(states[b].q.data()).transpose() << "]";
+        why << "get_state: body " << b << " (" << states[b].first << ") is not part of write (" << w << ", " << s
+            << "): q = [" << states[b].second.transpose() << "]";
         torn(why.str());
         return true;
       }
@@ -255,10 +227,9 @@ private:
 
   bool getMassMatrix()
   {
-    drb::GetMassMatrix service;
-    if (!call(get_mass_matrix_, service, "get_mass_matrix"))
+    std::vector<double> cos_theta;
+    if (!call("get_mass_matrix", [&] { cos_theta = client_.massMatrices().cos_theta; }))
       return false;
-    const auto& cos_theta = service.response.cos_theta;
     if (cos_theta.size() != facts_.names.size())
     {
       torn("get_mass_matrix: " + std::to_string(cos_theta.size()) + " matrices");
@@ -280,20 +251,19 @@ private:
 
   bool getVertexJacobians()
   {
-    drb::GetVertexJacobians service;
-    service.request.body = facts_.names[0];
-    if (!call(get_vertex_jacobians_, service, "get_vertex_jacobians"))
+    Eigen::Matrix3Xd positions;
+    if (!call("get_vertex_jacobians", [&] { positions = client_.vertexJacobians(facts_.names[0]).positions; }))
       return false;
-    const auto& positions = service.response.positions;
-    if (positions.size() != 3 * facts_.p0.size())
+    if (static_cast<std::size_t>(positions.cols()) != facts_.p0.size())
     {
-      torn("get_vertex_jacobians: " + std::to_string(positions.size()) + " position values");
+      torn("get_vertex_jacobians: " + std::to_string(positions.cols()) + " positions");
       return true;
     }
-    const Eigen::Vector3d first = Eigen::Map<const Eigen::Vector3d>(positions.data());
+    const Eigen::Vector3d first = positions.col(0);
     for (int w = kInitial; w < kClients; ++w)
     {
-      const Eigen::Matrix3d R = rotation(candidate(w, 0, 0));
+      const Vector6d q = candidate(w, 0, 0);
+      const Eigen::Matrix3d R = drb_test::refRotation(q[0], q[1], q[2]);
       const Eigen::Vector3d t = first - R * facts_.p0[0];
       long s = 0;
       if (w == kInitial)
@@ -311,8 +281,7 @@ private:
       const Eigen::Vector3d exact_t = candidate(w, s, 0).tail<3>();
       bool all = true;
       for (std::size_t i = 0; i < facts_.p0.size() && all; ++i)
-        all = ((R * facts_.p0[i] + exact_t) - Eigen::Map<const Eigen::Vector3d>(positions.data() + 3 * i)).norm() <=
-              kPositionTolerance;
+        all = ((R * facts_.p0[i] + exact_t) - positions.col(i)).norm() <= kPositionTolerance;
       if (all)
       {
         result.seen.push_back({ w, s });
@@ -325,25 +294,12 @@ private:
 
   bool backprop()
   {
-    drb::Backprop service;
-    service.request.body = facts_.names[0];
-    service.request.gradients = facts_.gradients;
-    if (!call(backprop_, service, "backprop"))
+    Vector6d got;
+    if (!call("backprop", [&] { got = client_.backprop(facts_.names[0], facts_.gradients); }))
       return false;
-    const Vector6d got = Eigen::Map<const Vector6d>(service.response.gradient.data());
     for (int w = kInitial; w < kClients; ++w)
     {
-      const Vector6d q = candidate(w, 0, 0);
-      const Eigen::Matrix3d R = rotation(q);
-      Eigen::Vector3d moment = Eigen::Vector3d::Zero(), force = Eigen::Vector3d::Zero();
-      for (std::size_t i = 0; i < facts_.p0.size(); ++i)
-      {
-        const Eigen::Vector3d g = Eigen::Map<const Eigen::Vector3d>(facts_.gradients.data() + 3 * i);
-        moment += (R * facts_.p0[i]).cross(g);
-        force += g;
-      }
-      Vector6d expected;
-      expected << angularVelocityMap(q).transpose() * moment, force;
+      const Vector6d expected = drb_test::refBackprop(candidate(w, 0, 0), facts_.p0, facts_.g);
       if ((expected - got).cwiseAbs().maxCoeff() <= kGradientTolerance * std::max(1.0, expected.cwiseAbs().maxCoeff()))
         return true;
     }
@@ -355,33 +311,26 @@ private:
   const SceneFacts& facts_;
   std::atomic<bool>& stop_;
   long sequence_ = 0;
-  ros::ServiceClient set_state_, get_state_, get_mass_matrix_, get_vertex_jacobians_, backprop_;
+  RigidBodyClient client_;
 };
 
 SceneFacts learnScene()
 {
-  const std::string server = "/rigid_body_server/";
-  for (const char* service : kServices)
-    if (!ros::service::waitForService(server + service, ros::Duration(60.0)))
-      throw std::runtime_error(server + service + " did not appear within 60 s");
+  RigidBodyClient client(ros::NodeHandle(), kServer, ros::Duration(60.0));
   SceneFacts facts;
-  drb::GetState state;
-  if (!ros::service::call(server + "get_state", state) || !state.response.success)
-    throw std::runtime_error("get_state failed");
-  for (const auto& body : state.response.states)
+  for (const auto& [name, q] : client.getState())
   {
-    facts.names.push_back(body.name);
-    facts.initial.push_back(Eigen::Map<const Vector6d>(body.q.data()));
+    facts.names.push_back(name);
+    facts.initial.push_back(q);
   }
-  drb::GetVertexJacobians vertices;  // at q = 0: positions are the body-frame vertices
-  vertices.request.body = facts.names.at(0);
-  vertices.request.q.assign(6, 0.0);
-  if (!ros::service::call(server + "get_vertex_jacobians", vertices) || !vertices.response.success)
-    throw std::runtime_error("get_vertex_jacobians failed");
-  for (std::size_t i = 0; i < vertices.response.positions.size() / 3; ++i)
+  // At q = 0 the positions are the body-frame vertices.
+  const Eigen::Matrix3Xd p0 = client.vertexJacobians(facts.names.at(0), Vector6d::Zero()).positions;
+  facts.gradients.resize(3, p0.cols());
+  for (Eigen::Index i = 0; i < p0.cols(); ++i)
   {
-    facts.p0.push_back(Eigen::Map<const Eigen::Vector3d>(vertices.response.positions.data() + 3 * i));
-    facts.gradients.insert(facts.gradients.end(), { 1.0 + i, -0.5 * i, 0.25 });
+    facts.p0.push_back(p0.col(i));
+    facts.g.emplace_back(1.0 + i, -0.5 * i, 0.25);
+    facts.gradients.col(i) = facts.g.back();
   }
   return facts;
 }
@@ -467,17 +416,4 @@ TEST(ReliabilityLoad, ConcurrentClientsSeeOnlyWholeAcknowledgedStates)
     for (const Seen& seen : client->result.seen)
       writers_seen.insert(seen.w);
   EXPECT_GE(writers_seen.size(), 3u) << "reads saw too few different writers to test interleaving";
-}
-
-int main(int argc, char** argv)
-{
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "reliability_load");
-  ros::NodeHandle nh;
-  ros::AsyncSpinner spinner(1);
-  spinner.start();
-  const int result = RUN_ALL_TESTS();
-  spinner.stop();
-  ros::shutdown();
-  return result;
 }

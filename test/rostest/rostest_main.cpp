@@ -1,4 +1,5 @@
-// main() of the rostest gtest node: ros::init (so that rostest's __name:=
+// main() of the rostest gtest nodes (rigid_body_server_rostest and
+// reliability_load_rostest): ros::init (so that rostest's __name:=
 // and __log:= arguments are consumed), a background spinner for the
 // subscriptions of the tests, then the tests.
 #include <memory>
@@ -6,19 +7,32 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
-#include "server_client.h"
+#include "server_under_test.h"
 
 namespace drb_rostest
 {
-ServerClient& server()
+namespace
 {
-  static std::unique_ptr<ServerClient> client;
+std::string serverName()
+{
+  return ros::NodeHandle("~").param<std::string>("server", "/rigid_body_server");
+}
+}  // namespace
+
+RigidBodyClient& server()
+{
+  static std::unique_ptr<RigidBodyClient> client;
   if (!client)
-  {
-    const std::string name = ros::NodeHandle("~").param<std::string>("server", "/rigid_body_server");
-    client = std::make_unique<ServerClient>(name);
-  }
+    client = std::make_unique<RigidBodyClient>(ros::NodeHandle(), serverName(), ros::Duration(60.0));
   return *client;
+}
+
+drb_test::RawServices& rawServer()
+{
+  static std::unique_ptr<drb_test::RawServices> raw;
+  if (!raw)
+    raw = std::make_unique<drb_test::RawServices>(serverName());
+  return *raw;
 }
 }  // namespace drb_rostest
 

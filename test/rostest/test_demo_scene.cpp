@@ -10,7 +10,7 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
-#include "server_client.h"
+#include "server_under_test.h"
 
 namespace drb_rostest
 {
@@ -20,23 +20,12 @@ constexpr double kTfTolerance = 1e-9;        // m
 constexpr double kLengthTolerance = 1e-12;   // m
 constexpr double kAngleTolerance = 1e-12;    // rad
 constexpr std::uint32_t kRockMeshVertices = 2562;  // urdf/meshes/rock.stl (demo_scene.urdf's comment)
-
-Eigen::Isometry3d toIsometry(const geometry_msgs::Transform& transform)
-{
-  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  X.linear() = Eigen::Quaterniond(transform.rotation.w, transform.rotation.x, transform.rotation.y,
-                                  transform.rotation.z)
-                   .toRotationMatrix();
-  X.translation() << transform.translation.x, transform.translation.y, transform.translation.z;
-  return X;
-}
 }  // namespace
 
 TEST(DemoScene, GetBodiesThroughServerLaunch)
 {
-  ServerClient demo("/rigid_body_server");
-  const drb::GetBodies::Response bodies = demo.getBodies();
-  ASSERT_TRUE(bodies.success) << bodies.message;
+  RigidBodyClient demo(ros::NodeHandle(), "/rigid_body_server", ros::Duration(60.0));
+  const diff_rigid_body_ros::Bodies bodies = demo.bodies();
   EXPECT_EQ(bodies.fixed_frame, "world");
   EXPECT_EQ(bodies.names, (std::vector<std::string>{ "knot", "rock" }));
   EXPECT_EQ(bodies.vertex_counts, (std::vector<std::uint32_t>{ 4096, 2626 }));
@@ -46,16 +35,14 @@ TEST(DemoScene, GetBodiesThroughServerLaunch)
   EXPECT_NEAR(bodies.masses[1], 1.39997 + 0.05, 1e-15);
 
   // Initial state of knot: rpy of its joint, t = its origin (COM at the link origin).
-  const drb::GetState::Response state = demo.getState({ "knot" });
-  ASSERT_TRUE(state.success) << state.message;
-  const Vector6d q = toVector(state.states.at(0));
-  EXPECT_LE((rpyRotation(q[0], q[1], q[2]) - rpyRotation(0, 0, 0.3)).cwiseAbs().maxCoeff(), kAngleTolerance);
+  const Vector6d q = demo.getState({ "knot" }).at(0).second;
+  EXPECT_LE((refRotation(q[0], q[1], q[2]) - refRotation(0.0, 0.0, 0.3)).cwiseAbs().maxCoeff(), kAngleTolerance);
   EXPECT_LE((q.tail<3>() - Eigen::Vector3d(-0.2, 0.05, 0.457)).norm(), kLengthTolerance);
 }
 
 TEST(DemoScene, MergedRockHandleAgreesWithTf)
 {
-  ServerClient demo("/rigid_body_server");
+  RigidBodyClient demo(ros::NodeHandle(), "/rigid_body_server", ros::Duration(60.0));
   tf2_ros::Buffer buffer;
   tf2_ros::TransformListener listener(buffer);
   const ros::Time stamp =
@@ -73,12 +60,12 @@ TEST(DemoScene, MergedRockHandleAgreesWithTf)
   std::vector<std::uint32_t> indices;
   for (std::uint32_t k = 0; k < handle.size(); ++k)
     indices.push_back(kRockMeshVertices + k);
-  const drb::GetVertexJacobians::Response answer = demo.getVertexJacobians("rock", {}, indices);
-  ASSERT_TRUE(answer.success) << answer.message;
+  const Eigen::Matrix3Xd positions = demo.vertexJacobians("rock", nullptr, indices).positions;
+  ASSERT_EQ(static_cast<std::size_t>(positions.cols()), handle.size());
   double max_error = 0.0;
   for (std::size_t k = 0; k < handle.size(); ++k)
   {
-    const double error = (X * handle[k] - positionOf(answer, k)).norm();
+    const double error = (X * handle[k] - positions.col(k)).norm();
     max_error = std::max(max_error, error);
     EXPECT_LE(error, kTfTolerance) << "rock_handle vertex " << k;
   }
@@ -92,32 +79,31 @@ TEST(DemoScene, MergedRockHandleAgreesWithTf)
 
 TEST(DemoScene, SecondInstanceInItsOwnNamespaceWithAFixedFrame)
 {
-  ServerClient second("/second_scene/rigid_body_server");
-  const drb::GetBodies::Response bodies = second.getBodies();
-  ASSERT_TRUE(bodies.success) << bodies.message;
+  RigidBodyClient second(ros::NodeHandle(), "/second_scene/rigid_body_server", ros::Duration(60.0));
+  const diff_rigid_body_ros::Bodies bodies = second.bodies();
   EXPECT_EQ(bodies.names, (std::vector<std::string>{ "brick", "tet", "roller" }));
   EXPECT_EQ(bodies.fixed_frame, "pedestal");
 
   // States are expressed in ~fixed_frame: the initial link pose and COM seen from pedestal.
   const FixtureScene fixture = fixtureScene();
   const Eigen::Isometry3d pedestal_from_world = fixture.static_links.at(0).pose.inverse();
-  const drb::GetState::Response state = second.getState();
-  ASSERT_TRUE(state.success) << state.message;
-  ASSERT_EQ(state.states.size(), fixture.bodies.size());
+  const NamedStates state = second.getState();
+  ASSERT_EQ(state.size(), fixture.bodies.size());
   for (std::size_t i = 0; i < fixture.bodies.size(); ++i)
   {
     const FixtureBody& body = fixture.bodies[i];
     const Eigen::Isometry3d link = pedestal_from_world * body.initial_link_pose;
-    const Vector6d q = toVector(state.states[i]);
-    EXPECT_LE((rpyRotation(q[0], q[1], q[2]) - link.linear()).cwiseAbs().maxCoeff(), kAngleTolerance) << body.name;
+    const Vector6d& q = state[i].second;
+    EXPECT_LE((refRotation(q[0], q[1], q[2]) - link.linear()).cwiseAbs().maxCoeff(), kAngleTolerance) << body.name;
     EXPECT_LE((q.tail<3>() - link * body.com_offset).norm(), kLengthTolerance) << body.name;
   }
 
-  // The instances are independent.
-  ASSERT_TRUE(second.setState({ bodyState("tet", Vector6d::Constant(0.5)) }).success);
-  ServerClient demo("/rigid_body_server");
-  const drb::SetState::Response refused = demo.setState({ bodyState("tet", Vector6d::Constant(0.5)) });
-  EXPECT_FALSE(refused.success) << "the demo scene has no body 'tet'";
+  // The instances are independent (and the second is left as it was found).
+  const NamedStates saved = second.getState();
+  second.setState("tet", Vector6d::Constant(0.5));
+  RigidBodyClient demo(ros::NodeHandle(), "/rigid_body_server", ros::Duration(60.0));
+  EXPECT_THROW(demo.setState("tet", Vector6d::Constant(0.5)), ServiceError) << "the demo scene has no body 'tet'";
+  second.setState(saved);
 }
 
 }  // namespace drb_rostest

@@ -20,7 +20,8 @@
 #include <gtest/gtest.h>
 #include <tf2_msgs/TFMessage.h>
 
-#include "server_client.h"
+#include "../support/expect_throws.h"
+#include "server_under_test.h"
 
 namespace drb_rostest
 {
@@ -40,7 +41,7 @@ double maxAbs(const Eigen::MatrixXd& m)
 }
 
 /// Index of `name` in a get_bodies answer; fails the test when it is absent.
-std::size_t indexOf(const drb::GetBodies::Response& bodies, const std::string& name)
+std::size_t indexOf(const diff_rigid_body_ros::Bodies& bodies, const std::string& name)
 {
   const auto found = std::find(bodies.names.begin(), bodies.names.end(), name);
   if (found == bodies.names.end())
@@ -50,17 +51,16 @@ std::size_t indexOf(const drb::GetBodies::Response& bodies, const std::string& n
 
 /// get_bodies' mass [kg], COM offset (link frame) [m] and inertia (about the
 /// COM, body axes) [kg m^2] of `name` against the expected values.
-void expectMassProperties(const drb::GetBodies::Response& bodies, const std::string& name, double mass,
+void expectMassProperties(const diff_rigid_body_ros::Bodies& bodies, const std::string& name, double mass,
                           const Eigen::Vector3d& com_offset, const Eigen::Matrix3d& inertia)
 {
   const std::size_t i = indexOf(bodies, name);
   EXPECT_LE(std::abs(bodies.masses[i] - mass), kRelativeTolerance * mass)
       << name << ": mass " << bodies.masses[i] << " kg, expected " << mass;
-  const Eigen::Vector3d com = Eigen::Map<const Eigen::Vector3d>(bodies.com_offsets.data() + 3 * i);
+  const Eigen::Vector3d& com = bodies.com_offsets.at(i);
   EXPECT_LE((com - com_offset).norm(), kLengthTolerance)
       << name << ": COM offset " << com.transpose() << ", expected " << com_offset.transpose();
-  const Eigen::Matrix3d served =
-      Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(bodies.inertias.data() + 9 * i);
+  const Eigen::Matrix3d& served = bodies.inertias.at(i);
   EXPECT_LE(maxAbs(served - inertia), kRelativeTolerance * maxAbs(inertia))
       << name << ": inertia\n" << served << "\nexpected\n" << inertia;
 }
@@ -69,12 +69,11 @@ void expectMassProperties(const drb::GetBodies::Response& bodies, const std::str
 /// served positions p = R p0 + t are p0.
 void expectVertices(const std::string& name, const std::vector<Eigen::Vector3d>& p0)
 {
-  const drb::GetVertexJacobians::Response answer = server().getVertexJacobians(name, std::vector<double>(6, 0.0));
-  ASSERT_TRUE(answer.success) << answer.message;
-  ASSERT_EQ(answer.positions.size(), 3 * p0.size()) << name;
+  const Eigen::Matrix3Xd positions = server().vertexJacobians(name, Vector6d::Zero()).positions;
+  ASSERT_EQ(static_cast<std::size_t>(positions.cols()), p0.size()) << name;
   for (std::size_t v = 0; v < p0.size(); ++v)
-    EXPECT_LE((positionOf(answer, v) - p0[v]).norm(), kLengthTolerance)
-        << name << " vertex " << v << ": " << positionOf(answer, v).transpose() << ", expected " << p0[v].transpose();
+    EXPECT_LE((positions.col(v) - p0[v]).norm(), kLengthTolerance)
+        << name << " vertex " << v << ": " << positions.col(v).transpose() << ", expected " << p0[v].transpose();
 }
 
 /// Child frames of every TFMessage received on a topic.
@@ -143,13 +142,12 @@ std::string joined(const std::set<std::string>& names)
 TEST(BodiesSubset, OnlyTheSelectedBodiesAreServed)
 {
   const FixtureScene fixture = fixtureScene();
-  const drb::GetBodies::Response bodies = server().getBodies();
-  ASSERT_TRUE(bodies.success) << bodies.message;
+  const diff_rigid_body_ros::Bodies bodies = server().bodies();
   EXPECT_EQ(std::set<std::string>(bodies.names.begin(), bodies.names.end()), kSelected);
   ASSERT_EQ(bodies.names.size(), kSelected.size());
   ASSERT_EQ(bodies.masses.size(), kSelected.size());
-  ASSERT_EQ(bodies.com_offsets.size(), 3 * kSelected.size());
-  ASSERT_EQ(bodies.inertias.size(), 9 * kSelected.size());
+  ASSERT_EQ(bodies.com_offsets.size(), kSelected.size());
+  ASSERT_EQ(bodies.inertias.size(), kSelected.size());
   ASSERT_EQ(bodies.vertex_counts.size(), kSelected.size());
   // The selected bodies are exactly as in the full scene.
   for (const std::string& name : kSelected)
@@ -161,35 +159,23 @@ TEST(BodiesSubset, OnlyTheSelectedBodiesAreServed)
   }
 
   // Initial states from the URDF: R(q) = the link's rotation, t = its COM.
-  const drb::GetState::Response state = server().getState();
-  ASSERT_TRUE(state.success) << state.message;
   std::set<std::string> stated;
-  for (const drb::BodyState& s : state.states)
+  for (const auto& [name, q] : server().getState())
   {
-    stated.insert(s.name);
-    if (!kSelected.count(s.name))
+    stated.insert(name);
+    if (!kSelected.count(name))
       continue;
-    const FixtureBody& body = fixture.body(s.name);
-    const Vector6d q = toVector(s);
-    EXPECT_LE(maxAbs(rpyRotation(q[0], q[1], q[2]) - body.initial_link_pose.linear()), kRelativeTolerance)
-        << s.name;
-    EXPECT_LE((q.tail<3>() - body.initial_link_pose * body.com_offset).norm(), kLengthTolerance) << s.name;
+    const FixtureBody& body = fixture.body(name);
+    EXPECT_LE(maxAbs(refRotation(q[0], q[1], q[2]) - body.initial_link_pose.linear()), kRelativeTolerance) << name;
+    EXPECT_LE((q.tail<3>() - body.initial_link_pose * body.com_offset).norm(), kLengthTolerance) << name;
   }
   EXPECT_EQ(stated, kSelected);
 
   // brick is unknown to every service.
-  const drb::GetState::Response brick_state = server().getState({ "brick" });
-  EXPECT_FALSE(brick_state.success);
-  EXPECT_NE(brick_state.message.find("unknown body 'brick'"), std::string::npos) << brick_state.message;
-  const drb::GetVertexJacobians::Response brick_vertices = server().getVertexJacobians("brick");
-  EXPECT_FALSE(brick_vertices.success);
-  EXPECT_NE(brick_vertices.message.find("unknown body 'brick'"), std::string::npos) << brick_vertices.message;
-  const drb::GetMassMatrix::Response brick_mass = server().getMassMatrix({ "brick" }, {}, false);
-  EXPECT_FALSE(brick_mass.success);
-  EXPECT_NE(brick_mass.message.find("unknown body 'brick'"), std::string::npos) << brick_mass.message;
-  const drb::SetState::Response set_brick = server().setState({ bodyState("brick", Vector6d::Zero()) });
-  EXPECT_FALSE(set_brick.success);
-  EXPECT_NE(set_brick.message.find("unknown body 'brick'"), std::string::npos) << set_brick.message;
+  DRB_EXPECT_THROWS_MESSAGE(server().getState({ "brick" }), ServiceError, "unknown body 'brick'");
+  DRB_EXPECT_THROWS_MESSAGE(server().vertexJacobians("brick"), ServiceError, "unknown body 'brick'");
+  DRB_EXPECT_THROWS_MESSAGE(server().massMatrices({ "brick" }, {}, false), ServiceError, "unknown body 'brick'");
+  DRB_EXPECT_THROWS_MESSAGE(server().setState("brick", Vector6d::Zero()), ServiceError, "unknown body 'brick'");
 }
 
 TEST(BodiesSubset, TfPublishesOnlyTheSelectedBodies)
@@ -230,8 +216,7 @@ TEST(VisualGeometry, VerticesComeFromVisualGeometry)
       body.finish();
     }
 
-  const drb::GetBodies::Response bodies = server().getBodies();
-  ASSERT_TRUE(bodies.success) << bodies.message;
+  const diff_rigid_body_ros::Bodies bodies = server().bodies();
   ASSERT_EQ(bodies.names.size(), fixture.bodies.size());
   for (std::size_t i = 0; i < fixture.bodies.size(); ++i)
   {
@@ -247,12 +232,10 @@ TEST(VisualGeometry, VerticesComeFromVisualGeometry)
   const FixtureBody& brick = fixture.body("brick");
   Vector6d q;
   q << 0.7, -0.3, 2.1, 0.4, -1.2, 0.9;
-  const drb::GetVertexJacobians::Response answer = server().getVertexJacobians("brick", toStdVector(q));
-  ASSERT_TRUE(answer.success) << answer.message;
-  ASSERT_EQ(answer.positions.size(), 3 * brick.p0.size());
+  const Eigen::Matrix3Xd positions = server().vertexJacobians("brick", q).positions;
+  ASSERT_EQ(static_cast<std::size_t>(positions.cols()), brick.p0.size());
   for (std::size_t v = 0; v < brick.p0.size(); ++v)
-    EXPECT_LE((positionOf(answer, v) - vertexPositionOracle(q, brick.p0[v])).norm(), kLengthTolerance)
-        << "brick vertex " << v;
+    EXPECT_LE((positions.col(v) - refPosition(q, brick.p0[v])).norm(), kLengthTolerance) << "brick vertex " << v;
 }
 
 // ---------------------------------------------------------------------------
@@ -270,8 +253,7 @@ TEST(VisualGeometry, VerticesComeFromVisualGeometry)
 
 TEST(Density, MassPropertiesFromClosedGeometry)
 {
-  const drb::GetBodies::Response bodies = server().getBodies();
-  ASSERT_TRUE(bodies.success) << bodies.message;
+  const diff_rigid_body_ros::Bodies bodies = server().bodies();
   EXPECT_EQ(bodies.names, (std::vector<std::string>{ "slab", "puck", "ball", "wedge", "anchor" }));
 
   {  // slab: box 0.4 x 0.2 x 0.1 at origin xyz (0.05, -0.02, 0.03), rpy (0.3, -0.2, 0.5)
@@ -279,7 +261,7 @@ TEST(Density, MassPropertiesFromClosedGeometry)
     const double m = kDensity * a * b * c;
     const Eigen::Matrix3d I_box =
         m / 12 * Eigen::Vector3d(b * b + c * c, a * a + c * c, a * a + b * b).asDiagonal().toDenseMatrix();
-    const Eigen::Matrix3d R_o = rpyRotation(0.3, -0.2, 0.5);
+    const Eigen::Matrix3d R_o = refRotation(0.3, -0.2, 0.5);
     const Eigen::Vector3d xyz(0.05, -0.02, 0.03);
     expectMassProperties(bodies, "slab", m, xyz, R_o * I_box * R_o.transpose());
     // Body frame at the COM: p0 = R_o corner + xyz - COM = R_o corner.

@@ -3,14 +3,15 @@
 //   (a) central finite differences of the positions and mass matrices the
 //       service itself returns at perturbed q (independent of its Jacobian
 //       and derivative code);
-//   (b) docs/derivation.md evaluated in the test (fixture_scene.h: AngleAxisd products,
-//       M = blockdiag(T^T R I_b R^T T, m I3), J = [-[R p0]_x T, I3],
-//       composite inertia by the parallel-axis theorem);
+//   (b) docs/derivation.md evaluated in the test (test/support/kinematics_oracles.h:
+//       products of elementary rotations, M = blockdiag(T^T R I_b R^T T, m I3),
+//       J = [-[R p0]_x T, I3]; fixture_scene.h: composite inertia by the
+//       parallel-axis theorem);
 //   (c) the core library loading the same URDF in this process.
+// The node is reached through the shipped C++ client (RigidBodyClient).
 //
-// Runs in services.test (fresh node); InitialState* must run before any
-// test that sets the state, so it comes first in this file (gtest runs tests
-// in definition order).
+// Runs in services.test (fresh node). Every test leaves the node's state as
+// it found it (RestoresState), so the tests run in any order.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -20,7 +21,7 @@
 #include <ros/package.h>
 
 #include "diff_rigid_body/urdf_scene.h"
-#include "server_client.h"
+#include "server_under_test.h"
 
 namespace drb_rostest
 {
@@ -94,6 +95,34 @@ const FixtureScene& fixture()
   return scene;
 }
 
+/// Every test of these suites restores the node's state when it ends.
+class Services : public RestoresState
+{
+};
+class GimbalLock : public RestoresState
+{
+};
+
+/// Central differences of the service's positions of `body` at q: column j
+/// of vertex v's block is (p_v(q + h e_j) - p_v(q - h e_j)) / (2 h).
+std::vector<Matrix36d> positionDifferences(const std::string& body, const Vector6d& q)
+{
+  std::vector<Matrix36d> fd;
+  for (int j = 0; j < 6; ++j)
+  {
+    Vector6d qp = q, qm = q;
+    qp[j] += kFiniteDifferenceStep;
+    qm[j] -= kFiniteDifferenceStep;
+    const Eigen::Matrix3Xd difference =
+        (server().vertexJacobians(body, qp).positions - server().vertexJacobians(body, qm).positions) /
+        (2 * kFiniteDifferenceStep);
+    fd.resize(difference.cols());
+    for (Eigen::Index v = 0; v < difference.cols(); ++v)
+      fd[v].col(j) = difference.col(v);
+  }
+  return fd;
+}
+
 std::string fixtureUrdfPath()
 {
   std::string path;
@@ -105,18 +134,17 @@ std::string fixtureUrdfPath()
 
 // ---------------------------------------------------------------------------
 
-TEST(Services, InitialStateFromUrdfJointOrigins)
+TEST_F(Services, InitialStateFromUrdfJointOrigins)
 {
-  const drb::GetState::Response state = server().getState();
-  ASSERT_TRUE(state.success) << state.message;
-  ASSERT_EQ(state.states.size(), fixture().bodies.size());
+  const NamedStates state = server().getState();
+  ASSERT_EQ(state.size(), fixture().bodies.size());
   MaxError rotation_error("initial state: R(q) vs joint origins"), com_error("initial state: t vs joint origins [m]");
   for (std::size_t i = 0; i < fixture().bodies.size(); ++i)
   {
     const FixtureBody& body = fixture().bodies[i];
-    EXPECT_EQ(state.states[i].name, body.name);
-    const Vector6d q = toVector(state.states[i]);
-    const Eigen::Matrix3d R = rpyRotation(q[0], q[1], q[2]);
+    EXPECT_EQ(state[i].first, body.name);
+    const Vector6d& q = state[i].second;
+    const Eigen::Matrix3d R = refRotation(q[0], q[1], q[2]);
     EXPECT_LE(rotation_error(maxAbs(R - body.initial_link_pose.linear())), kRelativeTolerance) << body.name;
     // t is the COM, not the link origin.
     EXPECT_LE(com_error((q.tail<3>() - body.initial_link_pose * body.com_offset).norm()), kLengthTolerance)
@@ -124,16 +152,15 @@ TEST(Services, InitialStateFromUrdfJointOrigins)
   }
 }
 
-TEST(Services, GetBodiesAgainstIndependentMassProperties)
+TEST_F(Services, GetBodiesAgainstIndependentMassProperties)
 {
-  const drb::GetBodies::Response bodies = server().getBodies();
-  ASSERT_TRUE(bodies.success) << bodies.message;
+  const diff_rigid_body_ros::Bodies bodies = server().bodies();
   EXPECT_EQ(bodies.fixed_frame, fixture().fixed_frame);
   const std::size_t n = fixture().bodies.size();
   ASSERT_EQ(bodies.names.size(), n);
   ASSERT_EQ(bodies.masses.size(), n);
-  ASSERT_EQ(bodies.inertias.size(), 9 * n);
-  ASSERT_EQ(bodies.com_offsets.size(), 3 * n);
+  ASSERT_EQ(bodies.inertias.size(), n);
+  ASSERT_EQ(bodies.com_offsets.size(), n);
   ASSERT_EQ(bodies.vertex_counts.size(), n);
   MaxError mass_error("get_bodies: mass vs parallel-axis oracle (rel)"),
       inertia_error("get_bodies: inertia vs parallel-axis oracle (rel)"),
@@ -145,22 +172,19 @@ TEST(Services, GetBodiesAgainstIndependentMassProperties)
     EXPECT_EQ(bodies.vertex_counts[i], body.expected_vertex_count) << body.name;
     EXPECT_EQ(body.p0.size(), body.expected_vertex_count) << "fixture transcription of " << body.name;
     EXPECT_LE(mass_error(std::abs(bodies.masses[i] - body.mass) / body.mass), kRelativeTolerance) << body.name;
-    const Eigen::Matrix3d inertia =
-        Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(bodies.inertias.data() + 9 * i);
+    const Eigen::Matrix3d& inertia = bodies.inertias[i];
     EXPECT_LE(inertia_error(maxAbs(inertia - body.inertia_body) / maxAbs(body.inertia_body)), kRelativeTolerance)
         << body.name << ":\n" << inertia << "\nexpected\n" << body.inertia_body;
-    const Eigen::Vector3d com(bodies.com_offsets[3 * i], bodies.com_offsets[3 * i + 1], bodies.com_offsets[3 * i + 2]);
-    EXPECT_LE(com_error((com - body.com_offset).norm()), kLengthTolerance) << body.name;
+    EXPECT_LE(com_error((bodies.com_offsets[i] - body.com_offset).norm()), kLengthTolerance) << body.name;
   }
 }
 
-TEST(Services, AgreesWithCoreLibraryOnTheSameUrdf)
+TEST_F(Services, AgreesWithCoreLibraryOnTheSameUrdf)
 {
   diff_rigid_body::SceneOptions options;
   options.find_package = [](const std::string& package) { return ros::package::getPath(package); };
   const diff_rigid_body::Scene scene = diff_rigid_body::loadSceneFromUrdfFile(fixtureUrdfPath(), options);
-  const drb::GetBodies::Response bodies = server().getBodies();
-  ASSERT_TRUE(bodies.success) << bodies.message;
+  const diff_rigid_body_ros::Bodies bodies = server().bodies();
   ASSERT_EQ(bodies.names.size(), scene.bodies.size());
   MaxError order_error("vertices in body frame vs fixture order [m]");
   for (std::size_t i = 0; i < scene.bodies.size(); ++i)
@@ -170,24 +194,22 @@ TEST(Services, AgreesWithCoreLibraryOnTheSameUrdf)
     EXPECT_EQ(bodies.names[i], core.name);
     EXPECT_EQ(bodies.masses[i], core.mass);
     for (int k = 0; k < 3; ++k)
-      EXPECT_EQ(bodies.com_offsets[3 * i + k], core.com_offset[k]);
+      EXPECT_EQ(bodies.com_offsets[i][k], core.com_offset[k]);
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c)
-        EXPECT_EQ(bodies.inertias[9 * i + 3 * r + c], core.inertia_body(r, c));
+        EXPECT_EQ(bodies.inertias[i](r, c), core.inertia_body(r, c));
     ASSERT_EQ(bodies.vertex_counts[i], static_cast<std::uint32_t>(core.vertices.cols()));
 
     // At q = 0, p = p0: the service's positions are the core's body-frame
     // vertices exactly, and those are the fixture's, in the documented order.
-    const drb::GetVertexJacobians::Response at_zero =
-        server().getVertexJacobians(core.name, std::vector<double>(6, 0.0));
-    ASSERT_TRUE(at_zero.success) << at_zero.message;
-    ASSERT_EQ(at_zero.positions.size(), 3u * core.vertices.cols());
+    const diff_rigid_body_ros::VertexJacobians at_zero = server().vertexJacobians(core.name, Vector6d::Zero());
+    ASSERT_EQ(at_zero.positions.cols(), core.vertices.cols());
     const FixtureBody& body = fixture().body(core.name);
     ASSERT_EQ(body.p0.size(), static_cast<std::size_t>(core.vertices.cols()));
     for (Eigen::Index v = 0; v < core.vertices.cols(); ++v)
     {
-      EXPECT_TRUE(positionOf(at_zero, v) == core.vertices.col(v))
-          << core.name << " vertex " << v << ": " << positionOf(at_zero, v).transpose() << " vs core "
+      EXPECT_TRUE(at_zero.positions.col(v) == core.vertices.col(v))
+          << core.name << " vertex " << v << ": " << at_zero.positions.col(v).transpose() << " vs core "
           << core.vertices.col(v).transpose();
       EXPECT_LE(order_error((core.vertices.col(v) - body.p0[v]).norm()), kLengthTolerance)
           << core.name << " vertex " << v << ": " << core.vertices.col(v).transpose() << ", fixture expects "
@@ -196,30 +218,27 @@ TEST(Services, AgreesWithCoreLibraryOnTheSameUrdf)
   }
 }
 
-TEST(Services, SetStateIsStoredBitForBit)
+TEST_F(Services, SetStateIsStoredBitForBit)
 {
-  const drb::GetState::Response before = server().getState();
-  ASSERT_TRUE(before.success) << before.message;
+  const NamedStates before = server().getState();
   // Angles far outside (-pi, pi], -0, a subnormal: stored as given, no wrapping.
   Vector6d brick, tet;
   brick << 1.0e6, -7.5, 3 * kPi, -0.0, 4.9e-324, 1e-300;
   tet << -12.25, kPi / 2, -kPi, 1e5, -2.0, 0.125;
-  const drb::SetState::Response set = server().setState({ bodyState("tet", tet), bodyState("brick", brick) });
-  ASSERT_TRUE(set.success) << set.message;
+  const NamedStates update = { { "tet", tet }, { "brick", brick } };
+  server().setState(update);
 
-  const drb::GetState::Response subset = server().getState({ "tet", "brick" });
-  ASSERT_TRUE(subset.success) << subset.message;
-  EXPECT_TRUE(bitwiseEqual(subset.states, { bodyState("tet", tet), bodyState("brick", brick) }))
-      << describe(subset.states);
+  const NamedStates subset = server().getState({ "tet", "brick" });
+  EXPECT_TRUE(bitwiseEqual(subset, update)) << describe(subset);
 
   // Bodies left out of the request keep their state.
-  const drb::GetState::Response all = server().getState();
-  ASSERT_TRUE(all.success) << all.message;
-  ASSERT_EQ(all.states.size(), 3u);
-  EXPECT_TRUE(bitwiseEqual({ all.states[2] }, { before.states[2] })) << describe(all.states);
+  const NamedStates all = server().getState();
+  ASSERT_EQ(all.size(), 3u);
+  ASSERT_EQ(before.size(), 3u);
+  EXPECT_TRUE(bitwiseEqual({ all[2] }, { before[2] })) << describe(all);
 }
 
-TEST(Services, MassMatricesAgainstOracleAndFiniteDifferences)
+TEST_F(Services, MassMatricesAgainstOracleAndFiniteDifferences)
 {
   const std::vector<Vector6d> states = testStates(11);
   const std::size_t n = fixture().bodies.size(), K = states.size();
@@ -230,11 +249,10 @@ TEST(Services, MassMatricesAgainstOracleAndFiniteDifferences)
     for (std::size_t i = 0; i < n; ++i)
       for (int j = 0; j < 6; ++j)
         q.push_back(state_of(k, i)[j]);
-  const drb::GetMassMatrix::Response answer = server().getMassMatrix({}, q, true);
-  ASSERT_TRUE(answer.success) << answer.message;
+  const diff_rigid_body_ros::MassMatrices answer = server().massMatrices({}, q, true);
   ASSERT_EQ(answer.bodies.size(), n);
-  ASSERT_EQ(answer.mass_matrices.size(), 36 * K * n);
-  ASSERT_EQ(answer.derivatives.size(), 216 * K * n);
+  ASSERT_EQ(answer.M.size(), K * n);
+  ASSERT_EQ(answer.dM.size(), K * n);
   ASSERT_EQ(answer.cos_theta.size(), K * n);
 
   // Finite differences from the service itself: one batched request with
@@ -250,9 +268,8 @@ TEST(Services, MassMatricesAgainstOracleAndFiniteDifferences)
           for (int c = 0; c < 6; ++c)
             q_fd.push_back(qi[c]);
         }
-  const drb::GetMassMatrix::Response perturbed = server().getMassMatrix({}, q_fd, false);
-  ASSERT_TRUE(perturbed.success) << perturbed.message;
-  ASSERT_EQ(perturbed.mass_matrices.size(), 36 * 12 * K * n);
+  const diff_rigid_body_ros::MassMatrices perturbed = server().massMatrices({}, q_fd, false);
+  ASSERT_EQ(perturbed.M.size(), 12 * K * n);
 
   MaxError m_error("M vs oracle T^T R I_b R^T T (rel)"), dm_error("dM/dq vs central differences of M (rel)"),
       cos_error("cos_theta vs cos(theta)");
@@ -263,8 +280,8 @@ TEST(Services, MassMatricesAgainstOracleAndFiniteDifferences)
       EXPECT_EQ(answer.bodies[i], body.name);
       const std::size_t slot = k * n + i;
       const Vector6d qi = state_of(k, i);
-      const Matrix6d M = matrixAt(answer.mass_matrices, slot);
-      const Matrix6d expected = massMatrixOracle(qi, body.mass, body.inertia_body);
+      const Matrix6d& M = answer.M[slot];
+      const Matrix6d expected = refMassMatrix(qi, body.mass, body.inertia_body);
       EXPECT_LE(m_error(maxAbs(M - expected) / maxAbs(expected)), kRelativeTolerance)
           << body.name << " at q = " << qi.transpose() << "\n" << M << "\nexpected\n" << expected;
       EXPECT_LE(maxAbs(M - M.transpose()), kRelativeTolerance * maxAbs(M)) << "M not symmetric:\n" << M;
@@ -272,9 +289,9 @@ TEST(Services, MassMatricesAgainstOracleAndFiniteDifferences)
       const double scale = std::max(1.0, maxAbs(M));
       for (int j = 0; j < 6; ++j)
       {
-        const Matrix6d dM = matrixAt(answer.derivatives, 6 * slot + j);
-        const Matrix6d plus = matrixAt(perturbed.mass_matrices, ((k * 6 + j) * 2 + 0) * n + i);
-        const Matrix6d minus = matrixAt(perturbed.mass_matrices, ((k * 6 + j) * 2 + 1) * n + i);
+        const Matrix6d& dM = answer.dM[slot][j];
+        const Matrix6d& plus = perturbed.M[((k * 6 + j) * 2 + 0) * n + i];
+        const Matrix6d& minus = perturbed.M[((k * 6 + j) * 2 + 1) * n + i];
         const Matrix6d fd = (plus - minus) / (2 * kFiniteDifferenceStep);
         EXPECT_LE(dm_error(maxAbs(dM - fd) / scale), kFiniteDifferenceTolerance)
             << body.name << " dM/dq_" << j << " at q = " << qi.transpose() << "\n" << dM << "\nfd\n" << fd;
@@ -287,85 +304,72 @@ TEST(Services, MassMatricesAgainstOracleAndFiniteDifferences)
 
   // Empty q means the current state; bodies come back in the requested order.
   const Vector6d roller_q = states[1], brick_q = states[4];
-  ASSERT_TRUE(server().setState({ bodyState("roller", roller_q), bodyState("brick", brick_q) }).success);
-  const drb::GetMassMatrix::Response current = server().getMassMatrix({ "roller", "brick" }, {}, false);
-  ASSERT_TRUE(current.success) << current.message;
+  server().setState({ { "roller", roller_q }, { "brick", brick_q } });
+  const diff_rigid_body_ros::MassMatrices current = server().massMatrices({ "roller", "brick" }, {}, false);
   ASSERT_EQ(current.bodies, (std::vector<std::string>{ "roller", "brick" }));
-  ASSERT_EQ(current.mass_matrices.size(), 72u);
-  const drb::GetMassMatrix::Response too_few =
-      server().getMassMatrix({ "roller", "brick" }, { roller_q.data(), roller_q.data() + 6 }, false);
-  ASSERT_FALSE(too_few.success) << "6 values for 2 bodies must be refused";
-  std::vector<double> both(roller_q.data(), roller_q.data() + 6);
+  ASSERT_EQ(current.M.size(), 2u);
+  ASSERT_THROW(server().massMatrices({ "roller", "brick" }, toStdVector(roller_q), false), ServiceError)
+      << "6 values for 2 bodies must be refused";
+  std::vector<double> both = toStdVector(roller_q);
   both.insert(both.end(), brick_q.data(), brick_q.data() + 6);
-  const drb::GetMassMatrix::Response with_q = server().getMassMatrix({ "roller", "brick" }, both, false);
-  ASSERT_TRUE(with_q.success) << with_q.message;
-  EXPECT_EQ(current.mass_matrices, with_q.mass_matrices);
-  EXPECT_TRUE(current.derivatives.empty());
+  const diff_rigid_body_ros::MassMatrices with_q = server().massMatrices({ "roller", "brick" }, both, false);
+  EXPECT_TRUE(current.M == with_q.M);
+  // The client does not show the derivatives array when none were asked for: a raw call does.
+  drb::GetMassMatrix::Request no_derivatives;
+  no_derivatives.bodies = { "roller", "brick" };
+  EXPECT_TRUE(rawServer().call<drb::GetMassMatrix>("get_mass_matrix", no_derivatives).derivatives.empty());
 }
 
-TEST(Services, VertexJacobiansAgainstOracleAndFiniteDifferences)
+TEST_F(Services, VertexJacobiansAgainstOracleAndFiniteDifferences)
 {
   MaxError p_error("positions vs oracle R p0 + t (rel)"), j_error("J vs oracle [-[R p0]x T, I3] (rel)"),
       fd_error("J vs central differences of positions (rel)");
   for (const FixtureBody& body : fixture().bodies)
     for (const Vector6d& q : testStates(23))
     {
-      const drb::GetVertexJacobians::Response answer = server().getVertexJacobians(body.name, toStdVector(q));
-      ASSERT_TRUE(answer.success) << answer.message;
+      const diff_rigid_body_ros::VertexJacobians answer = server().vertexJacobians(body.name, q);
       const std::size_t count = body.p0.size();
-      ASSERT_EQ(answer.positions.size(), 3 * count);
-      ASSERT_EQ(answer.jacobians.size(), 18 * count);
+      ASSERT_EQ(static_cast<std::size_t>(answer.positions.cols()), count);
+      ASSERT_EQ(static_cast<std::size_t>(answer.J.rows()), 3 * count);
 
-      std::vector<drb::GetVertexJacobians::Response> plus(6), minus(6);
-      for (int j = 0; j < 6; ++j)
-      {
-        Vector6d qp = q, qm = q;
-        qp[j] += kFiniteDifferenceStep;
-        qm[j] -= kFiniteDifferenceStep;
-        plus[j] = server().getVertexJacobians(body.name, toStdVector(qp));
-        minus[j] = server().getVertexJacobians(body.name, toStdVector(qm));
-        ASSERT_TRUE(plus[j].success && minus[j].success);
-      }
+      const std::vector<Matrix36d> fd = positionDifferences(body.name, q);
+      ASSERT_EQ(fd.size(), count);
       for (std::size_t v = 0; v < count; ++v)
       {
         const double scale = std::max(1.0, q.tail<3>().norm() + body.p0[v].norm());
-        EXPECT_LE(p_error((positionOf(answer, v) - vertexPositionOracle(q, body.p0[v])).norm() / scale),
-                  kRelativeTolerance)
+        EXPECT_LE(p_error((answer.positions.col(v) - refPosition(q, body.p0[v])).norm() / scale), kRelativeTolerance)
             << body.name << " vertex " << v;
-        const Matrix36d J = jacobianOf(answer, v);
-        const Matrix36d expected = vertexJacobianOracle(q, body.p0[v]);
+        const Matrix36d J = answer.jacobian(v);
+        const Matrix36d expected = refJacobianFromAngularVelocity(q, body.p0[v]);
         EXPECT_LE(j_error(maxAbs(J - expected) / std::max(1.0, maxAbs(expected))), kRelativeTolerance)
             << body.name << " vertex " << v << " at q = " << q.transpose() << "\n" << J << "\nexpected\n" << expected;
-        Matrix36d fd;
-        for (int j = 0; j < 6; ++j)
-          fd.col(j) = (positionOf(plus[j], v) - positionOf(minus[j], v)) / (2 * kFiniteDifferenceStep);
-        EXPECT_LE(fd_error(maxAbs(J - fd) / scale), kFiniteDifferenceTolerance)
-            << body.name << " vertex " << v << " at q = " << q.transpose() << "\n" << J << "\nfd\n" << fd;
+        EXPECT_LE(fd_error(maxAbs(J - fd[v]) / scale), kFiniteDifferenceTolerance)
+            << body.name << " vertex " << v << " at q = " << q.transpose() << "\n"
+            << J << "\nfd\n"
+            << fd[v];
       }
 
       // A selection returns those vertices, in the requested order.
       const std::vector<std::uint32_t> selection{ static_cast<std::uint32_t>(count - 1), 0, 3 };
-      const drb::GetVertexJacobians::Response some = server().getVertexJacobians(body.name, toStdVector(q), selection);
-      ASSERT_TRUE(some.success) << some.message;
-      ASSERT_EQ(some.positions.size(), 9u);
+      const diff_rigid_body_ros::VertexJacobians some = server().vertexJacobians(body.name, q, selection);
+      ASSERT_EQ(some.positions.cols(), 3);
       for (std::size_t s = 0; s < selection.size(); ++s)
       {
-        EXPECT_TRUE(positionOf(some, s) == positionOf(answer, selection[s]));
-        EXPECT_TRUE(jacobianOf(some, s) == jacobianOf(answer, selection[s]));
+        EXPECT_TRUE(some.positions.col(s) == answer.positions.col(selection[s]));
+        EXPECT_TRUE(some.jacobian(s) == answer.jacobian(selection[s]));
       }
     }
 
   // Empty q means the current state.
   const Vector6d q = testStates(5)[0];
-  ASSERT_TRUE(server().setState({ bodyState("tet", q) }).success);
-  const drb::GetVertexJacobians::Response current = server().getVertexJacobians("tet");
-  const drb::GetVertexJacobians::Response explicit_q = server().getVertexJacobians("tet", toStdVector(q));
-  ASSERT_TRUE(current.success && explicit_q.success);
-  EXPECT_EQ(current.positions, explicit_q.positions);
-  EXPECT_EQ(current.jacobians, explicit_q.jacobians);
+  server().setState("tet", q);
+  const diff_rigid_body_ros::VertexJacobians current = server().vertexJacobians("tet");
+  const diff_rigid_body_ros::VertexJacobians explicit_q = server().vertexJacobians("tet", q);
+  EXPECT_TRUE(current.positions == explicit_q.positions);
+  EXPECT_TRUE(current.J == explicit_q.J);
 }
 
-TEST(Services, BackpropAgainstJacobianTransposeOracleAndFiniteDifferences)
+TEST_F(Services, BackpropAgainstJacobianTransposeOracleAndFiniteDifferences)
 {
   std::mt19937 random(31);
   std::normal_distribution<double> normal;
@@ -375,29 +379,25 @@ TEST(Services, BackpropAgainstJacobianTransposeOracleAndFiniteDifferences)
     for (const Vector6d& q : testStates(37))
     {
       const std::size_t count = body.p0.size();
-      std::vector<double> g(3 * count);
+      Eigen::Matrix3Xd g(3, count);
       std::vector<Eigen::Vector3d> g3(count);
       for (std::size_t v = 0; v < count; ++v)
         for (int c = 0; c < 3; ++c)
-          g[3 * v + c] = g3[v][c] = normal(random);
-      const drb::Backprop::Response answer = server().backprop(body.name, g, toStdVector(q));
-      ASSERT_TRUE(answer.success) << answer.message;
-      const Vector6d gradient = Eigen::Map<const Vector6d>(answer.gradient.data());
+          g(c, v) = g3[v][c] = normal(random);
+      const Vector6d gradient = server().backprop(body.name, g, q);
 
-      const drb::GetVertexJacobians::Response jacobians = server().getVertexJacobians(body.name, toStdVector(q));
-      ASSERT_TRUE(jacobians.success) << jacobians.message;
+      const diff_rigid_body_ros::VertexJacobians jacobians = server().vertexJacobians(body.name, q);
       Vector6d jt = Vector6d::Zero();
       double magnitude = 0.0;  // sum |J^T| |g|: the scale of the rounding in the sum
       for (std::size_t v = 0; v < count; ++v)
       {
-        jt += jacobianOf(jacobians, v).transpose() * g3[v];
-        magnitude += maxAbs(jacobianOf(jacobians, v)) * g3[v].norm();
+        jt += jacobians.jacobian(v).transpose() * g3[v];
+        magnitude += maxAbs(jacobians.jacobian(v)) * g3[v].norm();
       }
       const double scale = std::max(1.0, magnitude);
       EXPECT_LE(jt_error(maxAbs(gradient - jt) / scale), kRelativeTolerance)
           << body.name << ": " << gradient.transpose() << " vs " << jt.transpose();
-      EXPECT_LE(oracle_error(maxAbs(gradient - backpropOracle(q, body.p0, g3)) / scale), kRelativeTolerance)
-          << body.name;
+      EXPECT_LE(oracle_error(maxAbs(gradient - refBackprop(q, body.p0, g3)) / scale), kRelativeTolerance) << body.name;
 
       // L(q) = sum_i g_i . p_i(q), differentiated through the service's positions.
       for (int j = 0; j < 6; ++j)
@@ -407,11 +407,10 @@ TEST(Services, BackpropAgainstJacobianTransposeOracleAndFiniteDifferences)
         {
           Vector6d qs = q;
           qs[j] += (s == 0 ? 1 : -1) * kFiniteDifferenceStep;
-          const drb::GetVertexJacobians::Response p = server().getVertexJacobians(body.name, toStdVector(qs));
-          ASSERT_TRUE(p.success);
+          const diff_rigid_body_ros::VertexJacobians p = server().vertexJacobians(body.name, qs);
           loss[s] = 0.0;
           for (std::size_t v = 0; v < count; ++v)
-            loss[s] += g3[v].dot(positionOf(p, v));
+            loss[s] += g3[v].dot(p.positions.col(v));
         }
         EXPECT_LE(fd_error(std::abs(gradient[j] - (loss[0] - loss[1]) / (2 * kFiniteDifferenceStep)) / scale),
                   kFiniteDifferenceTolerance)
@@ -420,13 +419,12 @@ TEST(Services, BackpropAgainstJacobianTransposeOracleAndFiniteDifferences)
 
       // A selection: only those vertices' gradients.
       const std::vector<std::uint32_t> selection{ 1, static_cast<std::uint32_t>(count - 1) };
-      std::vector<double> g_some{ g[3], g[4], g[5], g[3 * count - 3], g[3 * count - 2], g[3 * count - 1] };
-      const drb::Backprop::Response some = server().backprop(body.name, g_some, toStdVector(q), selection);
-      ASSERT_TRUE(some.success) << some.message;
-      const Vector6d expected_some = jacobianOf(jacobians, 1).transpose() * g3[1] +
-                                     jacobianOf(jacobians, count - 1).transpose() * g3[count - 1];
-      EXPECT_LE(jt_error(maxAbs(Eigen::Map<const Vector6d>(some.gradient.data()) - expected_some) / scale),
-                kRelativeTolerance);
+      Eigen::Matrix3Xd g_some(3, 2);
+      g_some << g.col(1), g.col(count - 1);
+      const Vector6d some = server().backprop(body.name, g_some, q, selection);
+      const Vector6d expected_some =
+          jacobians.jacobian(1).transpose() * g3[1] + jacobians.jacobian(count - 1).transpose() * g3[count - 1];
+      EXPECT_LE(jt_error(maxAbs(some - expected_some) / scale), kRelativeTolerance);
     }
 }
 
@@ -435,7 +433,7 @@ TEST(Services, BackpropAgainstJacobianTransposeOracleAndFiniteDifferences)
 // its negative). Everything stays finite, cos_theta says how close it is, and
 // the answers still agree with the oracle.
 
-TEST(GimbalLock, FiniteAnswersAndCosThetaReported)
+TEST_F(GimbalLock, FiniteAnswersAndCosThetaReported)
 {
   const FixtureBody& body = fixture().body("tet");
   MaxError m_error("gimbal lock: M vs oracle (rel)"), j_error("gimbal lock: J vs oracle (rel)"),
@@ -445,17 +443,16 @@ TEST(GimbalLock, FiniteAnswersAndCosThetaReported)
     SCOPED_TRACE("theta = pi/2 " + std::string(theta == kPi / 2 ? "exactly" : theta < 0 ? "negated" : "- 1e-9"));
     Vector6d q;
     q << 0.3, theta, -1.2, 0.1, 0.2, 0.3;
-    const drb::GetMassMatrix::Response mass = server().getMassMatrix({ "tet" }, toStdVector(q), true);
-    ASSERT_TRUE(mass.success) << mass.message;
+    const diff_rigid_body_ros::MassMatrices mass = server().massMatrices({ "tet" }, toStdVector(q), true);
     ASSERT_EQ(mass.cos_theta.size(), 1u);
-    for (double v : mass.mass_matrices)
-      ASSERT_TRUE(std::isfinite(v));
-    for (double v : mass.derivatives)
-      ASSERT_TRUE(std::isfinite(v));
+    ASSERT_EQ(mass.M.size(), 1u);
+    ASSERT_TRUE(mass.M[0].allFinite());
+    for (const Matrix6d& dM : mass.dM.at(0))
+      ASSERT_TRUE(dM.allFinite());
     EXPECT_EQ(mass.cos_theta[0], std::cos(theta));  // 1e-9 or 6.12e-17: reported, not rounded to 0
     EXPECT_GT(mass.cos_theta[0], 0.0);
-    const Matrix6d M = matrixAt(mass.mass_matrices, 0);
-    const Matrix6d expected = massMatrixOracle(q, body.mass, body.inertia_body);
+    const Matrix6d& M = mass.M[0];
+    const Matrix6d expected = refMassMatrix(q, body.mass, body.inertia_body);
     EXPECT_LE(m_error(maxAbs(M - expected) / maxAbs(expected)), kRelativeTolerance) << M << "\nexpected\n" << expected;
     // det(T^T I' T) = cos^2(theta) det(I_b): rank 5 at the lock, but finite.
     const double det = M.topLeftCorner<3, 3>().determinant();
@@ -463,42 +460,27 @@ TEST(GimbalLock, FiniteAnswersAndCosThetaReported)
                 1e-12 * std::pow(maxAbs(body.inertia_body), 3));
 
     // The state is accepted and stored exactly; the current-state answers are finite.
-    ASSERT_TRUE(server().setState({ bodyState("tet", q) }).success);
-    const drb::GetState::Response state = server().getState({ "tet" });
-    ASSERT_TRUE(state.success);
-    EXPECT_TRUE(bitwiseEqual(state.states, { bodyState("tet", q) })) << describe(state.states);
-    const drb::GetMassMatrix::Response current = server().getMassMatrix({ "tet" }, {}, false);
-    ASSERT_TRUE(current.success);
+    server().setState("tet", q);
+    const NamedStates state = server().getState({ "tet" });
+    EXPECT_TRUE(bitwiseEqual(state, { { "tet", q } })) << describe(state);
+    const diff_rigid_body_ros::MassMatrices current = server().massMatrices({ "tet" }, {}, false);
+    ASSERT_EQ(current.cos_theta.size(), 1u);
     EXPECT_EQ(current.cos_theta[0], std::cos(theta));
 
-    const drb::GetVertexJacobians::Response answer = server().getVertexJacobians("tet");
-    ASSERT_TRUE(answer.success) << answer.message;
-    for (double v : answer.jacobians)
-      ASSERT_TRUE(std::isfinite(v));
-    std::vector<drb::GetVertexJacobians::Response> plus(6), minus(6);
-    for (int j = 0; j < 6; ++j)
-    {
-      Vector6d qp = q, qm = q;
-      qp[j] += kFiniteDifferenceStep;
-      qm[j] -= kFiniteDifferenceStep;
-      plus[j] = server().getVertexJacobians("tet", toStdVector(qp));
-      minus[j] = server().getVertexJacobians("tet", toStdVector(qm));
-      ASSERT_TRUE(plus[j].success && minus[j].success);
-    }
+    const diff_rigid_body_ros::VertexJacobians answer = server().vertexJacobians("tet");
+    ASSERT_TRUE(answer.J.allFinite());
+    const std::vector<Matrix36d> fd = positionDifferences("tet", q);
+    ASSERT_EQ(fd.size(), body.p0.size());
     for (std::size_t v = 0; v < body.p0.size(); ++v)
     {
-      const Matrix36d J = jacobianOf(answer, v);
-      EXPECT_LE(j_error(maxAbs(J - vertexJacobianOracle(q, body.p0[v]))), kRelativeTolerance) << "vertex " << v;
-      Matrix36d fd;
-      for (int j = 0; j < 6; ++j)
-        fd.col(j) = (positionOf(plus[j], v) - positionOf(minus[j], v)) / (2 * kFiniteDifferenceStep);
-      EXPECT_LE(fd_error(maxAbs(J - fd)), kFiniteDifferenceTolerance) << "vertex " << v;
+      const Matrix36d J = answer.jacobian(v);
+      EXPECT_LE(j_error(maxAbs(J - refJacobianFromAngularVelocity(q, body.p0[v]))), kRelativeTolerance)
+          << "vertex " << v;
+      EXPECT_LE(fd_error(maxAbs(J - fd[v])), kFiniteDifferenceTolerance) << "vertex " << v;
     }
-    std::vector<double> g(3 * body.p0.size(), 1.0);
-    const drb::Backprop::Response back = server().backprop("tet", g);
-    ASSERT_TRUE(back.success) << back.message;
-    for (double v : back.gradient)
-      EXPECT_TRUE(std::isfinite(v));
+    const Vector6d back = server().backprop("tet", Eigen::Matrix3Xd::Ones(3, body.p0.size()));
+    for (int j = 0; j < 6; ++j)
+      EXPECT_TRUE(std::isfinite(back[j]));
   }
 }
 

@@ -5,7 +5,8 @@
 // set_state. Static links are on /tf_static only; body frames go out on /tf
 // in one message per publication.
 //
-// Runs in tf.test (fresh node): the initial-state test comes first.
+// Runs in tf.test (fresh node). Every test leaves the node's state as it
+// found it (RestoresState), so the tests run in any order.
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -17,7 +18,7 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
-#include "server_client.h"
+#include "server_under_test.h"
 
 namespace drb_rostest
 {
@@ -29,16 +30,6 @@ constexpr double kTfTolerance = 1e-9;  // m
 /// tf rotations against the fixture's joint origins.
 constexpr double kRotationTolerance = 1e-9;  // 1
 const double kTimeout = 10.0;  // s
-
-Eigen::Isometry3d toIsometry(const geometry_msgs::Transform& transform)
-{
-  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  X.linear() = Eigen::Quaterniond(transform.rotation.w, transform.rotation.x, transform.rotation.y,
-                                  transform.rotation.z)
-                   .toRotationMatrix();
-  X.translation() << transform.translation.x, transform.translation.y, transform.translation.z;
-  return X;
-}
 
 const FixtureScene& fixture()
 {
@@ -80,7 +71,7 @@ private:
   ros::Subscriber subscriber_;
 };
 
-class Tf : public ::testing::Test
+class Tf : public RestoresState
 {
 protected:
   Tf() : buffer_(ros::Duration(30.0)), listener_(buffer_) {}
@@ -114,9 +105,8 @@ protected:
     double max_error = 0.0;
     for (const FixtureBody& body : fixture().bodies)
     {
-      const drb::GetVertexJacobians::Response answer = server().getVertexJacobians(body.name);
-      ASSERT_TRUE(answer.success) << answer.message;
-      ASSERT_EQ(answer.positions.size(), 3 * body.p0.size()) << body.name;
+      const Eigen::Matrix3Xd positions = server().vertexJacobians(body.name).positions;
+      ASSERT_EQ(static_cast<std::size_t>(positions.cols()), body.p0.size()) << body.name;
       for (std::size_t l = 0; l < body.links.size(); ++l)
       {
         const FixtureLink& link = body.links[l];
@@ -125,12 +115,12 @@ protected:
         for (std::size_t k = 0; k < link.vertices.size(); ++k)
         {
           const std::size_t index = body.vertex_index[l][k];
-          const double error = (X * link.vertices[k] - positionOf(answer, index)).norm();
+          const double error = (X * link.vertices[k] - positions.col(index)).norm();
           max_error = std::max(max_error, error);
-          EXPECT_LE(error, kTfTolerance) << when << ": link '" << link.name << "' geometry vertex " << k
-                                         << " (body '" << body.name << "' vertex " << index << "): tf gives "
+          EXPECT_LE(error, kTfTolerance) << when << ": link '" << link.name << "' geometry vertex " << k << " (body '"
+                                         << body.name << "' vertex " << index << "): tf gives "
                                          << (X * link.vertices[k]).transpose() << ", service "
-                                         << positionOf(answer, index).transpose();
+                                         << positions.col(index).transpose();
         }
       }
     }
@@ -145,7 +135,9 @@ protected:
 
 TEST_F(Tf, InitialFramesFollowJointOriginsAndAgreeWithPositions)
 {
-  const ros::Time stamp = waitForStampAfter("brick", ros::Time(0));
+  // A publication stamped after the start of the test carries the state
+  // the test found (the initial one: every test restores it).
+  const ros::Time stamp = waitForStampAfter("brick", ros::Time::now());
   for (const FixtureBody& body : fixture().bodies)
     for (const FixtureLink& link : body.links)
     {
@@ -164,19 +156,17 @@ TEST_F(Tf, AgreesWithPositionsAfterSetState)
   brick << 0.4, -0.7, 2.9, 0.3, -1.2, 2.5;
   tet << -1.1, kPi / 2 - 1e-9, 0.6, -0.5, 0.75, 1.25;  // near gimbal lock
   roller << 31.0, 1.2, -100.5, 2.0, 0.0, -0.5;         // angles far outside (-pi, pi]
-  const drb::SetState::Response set =
-      server().setState({ bodyState("brick", brick), bodyState("tet", tet), bodyState("roller", roller) });
-  ASSERT_TRUE(set.success) << set.message;
+  server().setState({ { "brick", brick }, { "tet", tet }, { "roller", roller } });
   // Any publication stamped after set_state returned carries the new state.
   expectTfAgreesWithPositions(waitForStampAfter("brick", ros::Time::now()), "after_set_state");
 
   // A second change, of one body only, shows up too.
   brick << -2.0, 0.3, 0.1, -0.25, 0.5, 0.125;
-  ASSERT_TRUE(server().setState({ bodyState("brick", brick) }).success);
+  server().setState("brick", brick);
   const ros::Time stamp = waitForStampAfter("brick", ros::Time::now());
   expectTfAgreesWithPositions(stamp, "after_second_set_state");
   const Eigen::Isometry3d X = toIsometry(buffer_.lookupTransform(fixture().fixed_frame, "brick", stamp).transform);
-  EXPECT_LE((X.linear() - rpyRotation(brick[0], brick[1], brick[2])).cwiseAbs().maxCoeff(), kRotationTolerance);
+  EXPECT_LE((X.linear() - refRotation(brick[0], brick[1], brick[2])).cwiseAbs().maxCoeff(), kRotationTolerance);
 }
 
 TEST_F(Tf, StaticLinksOnTfStaticOnly)
