@@ -22,6 +22,7 @@
 #include "bench_common.h"
 #include "diff_rigid_body/mass_matrix.h"
 #include "diff_rigid_body/vertex_jacobian.h"
+#include "reference/vertex_kernels.h"
 
 #ifdef DRB_BENCH_HAVE_KDL
 #include <kdl/chain.hpp>

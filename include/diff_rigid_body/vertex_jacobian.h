@@ -1,5 +1,6 @@
-// Vertex positions, vertex Jacobians and their vector-Jacobian product,
-// templated on the scalar (pose and J: body_pose.h).
+// Vertex positions, vertex Jacobians and their vector-Jacobian product for
+// many vertices at once, templated on the scalar (pose and J: body_pose.h;
+// one vertex at a time, for tests: bench/reference/vertex_kernels.h).
 //
 //   p = R(r) p0 + t,   J = dp/dq = [ -[R p0]_x T | I3 ]
 //
@@ -26,25 +27,6 @@
 
 namespace diff_rigid_body
 {
-/// p = R p0 + t.
-template <typename Scalar>
-Vector3<Scalar> vertexPosition(const BodyPose<Scalar>& pose, const Vector3<Scalar>& p0)
-{
-  return detail::rotate(pose.R, p0) + pose.t;
-}
-
-/// J = dp/dq (3x6) for one body-frame vertex p0.
-template <typename Scalar>
-Matrix36<Scalar> vertexJacobian(const BodyPose<Scalar>& pose, const Vector3<Scalar>& p0)
-{
-  const Vector3<Scalar> lever = detail::rotate(pose.R, p0);
-  Matrix36<Scalar> J;
-  for (int k = 0; k < 3; ++k)
-    J.col(k) = detail::cross(pose.T.col(k), lever);
-  J.template rightCols<3>().setIdentity();
-  return J;
-}
-
 /// Outputs of at least this many bytes are written with non-temporal
 /// (streaming) stores in double: they cannot stay in cache anyway, and
 /// streaming them skips the read-for-ownership of every output line, which

@@ -23,6 +23,8 @@
 #include "diff_rigid_body/mass_matrix.h"
 #include "diff_rigid_body/vertex_jacobian.h"
 #include "reference/gimbal_lock.h"
+#include "reference/rpy_derivatives.h"
+#include "reference/vertex_kernels.h"
 #include "../support/oracles.h"
 
 namespace drb = diff_rigid_body;

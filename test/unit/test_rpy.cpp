@@ -20,6 +20,7 @@
 #include <tf2/LinearMath/Matrix3x3.h>
 
 #include "diff_rigid_body/rpy.h"
+#include "reference/rpy_derivatives.h"
 #include "../support/oracles.h"
 
 namespace drb = diff_rigid_body;
