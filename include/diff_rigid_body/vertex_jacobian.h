@@ -27,15 +27,6 @@
 
 namespace diff_rigid_body
 {
-/// Outputs of at least this many bytes are written with non-temporal
-/// (streaming) stores in double: they cannot stay in cache anyway, and
-/// streaming them skips the read-for-ownership of every output line, which
-/// is what keeps the kernel at the speed of a memcpy of its output
-/// (bench/, docs/benchmarks.md). Smaller outputs use ordinary stores, so
-/// that a consumer that reads them next (e.g. message serialisation) finds
-/// them in cache.
-constexpr std::size_t kStreamingStoreBytes = std::size_t(16) << 20;
-
 namespace detail
 {
 /// Number of selected vertices: indices.size(), or every vertex when empty.
@@ -68,25 +59,18 @@ void writeSelectedVertices(const BodyPose<Scalar>& pose, const Matrix3X<Scalar>&
 ///                  must already be validated (< vertices.cols()).
 /// \param positions out, 3 * count values, or nullptr to skip
 /// \param jacobians out, 18 * count values, or nullptr to skip
+///
+/// In double, outputs of kStreamingStoreBytes or more are written with
+/// streaming stores (detail/vertex_kernels_sse2.h).
 template <typename Scalar>
 void vertexPositionsAndJacobians(const BodyPose<Scalar>& pose, const Matrix3X<Scalar>& vertices,
                                  const std::vector<std::uint32_t>& indices, Scalar* positions, Scalar* jacobians)
 {
-#if defined(DRB_VERTEX_KERNELS_SSE2)
   if constexpr (std::is_same<Scalar, double>::value)
   {
-    if (jacobians)
-    {
-      const bool aligned = reinterpret_cast<std::uintptr_t>(jacobians) % 16 == 0 &&
-                           reinterpret_cast<std::uintptr_t>(positions) % 16 == 0;  // null is aligned
-      if (aligned && 18 * sizeof(double) * detail::selectedCount(vertices, indices) >= kStreamingStoreBytes)
-        detail::positionsAndJacobiansSse2<true>(pose, vertices, indices, positions, jacobians);
-      else
-        detail::positionsAndJacobiansSse2<false>(pose, vertices, indices, positions, jacobians);
+    if (detail::positionsAndJacobiansSimd(pose, vertices, indices, positions, jacobians))
       return;
-    }
   }
-#endif
   detail::writeSelectedVertices<6>(pose, vertices, indices, positions, jacobians);
 }
 

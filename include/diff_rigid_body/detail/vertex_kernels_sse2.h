@@ -1,7 +1,8 @@
 // Positions and Jacobians of many vertices in double, two vertices per SSE2
 // register, with streaming stores for outputs too large for the cache. The
 // same bits as the portable loop of vertex_jacobian.h (rotate() and cross()
-// lane by lane). x86-64 only (DRB_VERTEX_KERNELS_SSE2).
+// lane by lane). x86-64 only (DRB_VERTEX_KERNELS_SSE2); elsewhere
+// positionsAndJacobiansSimd declines and the portable loop runs.
 #pragma once
 
 #include <cstddef>
@@ -12,11 +13,20 @@
 #include "diff_rigid_body/detail/cpu_features.h"
 #include "diff_rigid_body/types.h"
 
-#if defined(DRB_VERTEX_KERNELS_SSE2)
 namespace diff_rigid_body
 {
+/// Outputs of at least this many bytes are written with non-temporal
+/// (streaming) stores in double: they cannot stay in cache anyway, and
+/// streaming them skips the read-for-ownership of every output line, which
+/// is what keeps the kernel at the speed of a memcpy of its output
+/// (bench/, docs/benchmarks.md). Smaller outputs use ordinary stores, so
+/// that a consumer that reads them next (e.g. message serialisation) finds
+/// them in cache.
+constexpr std::size_t kStreamingStoreBytes = std::size_t(16) << 20;
+
 namespace detail
 {
+#if defined(DRB_VERTEX_KERNELS_SSE2)
 /// Loads the coordinates of vertices a and b into lanes (a, b).
 inline void loadVertexPair(const double* a, const double* b, __m128d& X, __m128d& Y, __m128d& Z)
 {
@@ -149,6 +159,31 @@ inline void positionsAndJacobiansSse2(const BodyPose<double>& pose, const Matrix
     writeVertexOutputs<6>(pose, rotate(pose.R, Eigen::Map<const Vector3<double>>(vertex(n))),
                           positions ? positions + 3 * n : nullptr, jacobians + 18 * n);
 }
+#endif
+
+/// vertexPositionsAndJacobians in double on the SIMD path: streaming stores
+/// for large 16-byte aligned outputs, ordinary ones otherwise. Returns false,
+/// having written nothing, when there is no SIMD path (not x86-64) or no
+/// Jacobians are asked for (positions alone: the portable loop).
+inline bool positionsAndJacobiansSimd(const BodyPose<double>& pose, const Matrix3X<double>& vertices,
+                                      const std::vector<std::uint32_t>& indices, double* positions,
+                                      double* jacobians)
+{
+#if defined(DRB_VERTEX_KERNELS_SSE2)
+  if (!jacobians)
+    return false;
+  const std::size_t count = indices.empty() ? static_cast<std::size_t>(vertices.cols()) : indices.size();
+  const bool aligned = reinterpret_cast<std::uintptr_t>(jacobians) % 16 == 0 &&
+                       reinterpret_cast<std::uintptr_t>(positions) % 16 == 0;  // null is aligned
+  if (aligned && 18 * sizeof(double) * count >= kStreamingStoreBytes)
+    positionsAndJacobiansSse2<true>(pose, vertices, indices, positions, jacobians);
+  else
+    positionsAndJacobiansSse2<false>(pose, vertices, indices, positions, jacobians);
+  return true;
+#else
+  (void)pose, (void)vertices, (void)indices, (void)positions, (void)jacobians;
+  return false;
+#endif
+}
 }  // namespace detail
 }  // namespace diff_rigid_body
-#endif
