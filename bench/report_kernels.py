@@ -171,7 +171,8 @@ def section_jacobians(k, acc, targets, floor_rows):
         if t and fl:
             for p, name in PATHS:
                 if p in fl:
-                    floor_rows.append([f"{s} ({items:,})", "positions + J (SSE2 kernel)", fmt_time(t),
+                    floor_rows.append([f"{s} ({items:,})", "positions + J (SSE2 kernel)",
+                                       "yes, on every x86-64: `vertexPositionsAndJacobians`", fmt_time(t),
                                        f"write, {name} stores", fmt_time(fl[p]), f"{t / fl[p]:.2f}"])
             on_paths = {p: t / fl[p] for p in ("avx2", "avx512") if p in fl}
             if on_paths:
@@ -185,7 +186,9 @@ def section_jacobians(k, acc, targets, floor_rows):
     return "\n".join(text)
 
 
-NODE_BP = "yes: `SceneQueries::backprop` → `backpropagateVertexGradients` (vertex_columns.h)"
+NODE_ON_PATH = {"avx512": "yes, on CPUs with AVX-512F (this one)",
+                "avx2": "yes, on CPUs with AVX2 + FMA but not AVX-512F",
+                "sse2": "yes, on CPUs without AVX2 (the portable loop)"}
 
 
 def backprop_rows(k, s):
@@ -210,7 +213,8 @@ def backprop_floor_targets(k, s, items, targets, floor_rows):
         t = cpu(k, f"{prefix}/columns_on_{p}")
         if t is None or p not in fl:
             continue
-        floor_rows.append([f"{s} ({items:,})", f"backprop, {name} path", fmt_time(t), f"read, {name} loads",
+        floor_rows.append([f"{s} ({items:,})", f"backprop, {name} path", NODE_ON_PATH[p], fmt_time(t),
+                           f"read, {name} loads",
                            fmt_time(fl[p]), f"{t / fl[p]:.2f}"])
         if p != "sse2":
             on_paths[p] = t / fl[p]
@@ -294,7 +298,8 @@ def section_floors(floor_rows):
         "is measured against the floors of each width. A ratio below 1 means the kernel beats the plain loop "
         "(e.g. through software prefetch).",
         "",
-        md_table(["vertex set", "kernel", "kernel / vertex", "floor", "floor / vertex", "kernel ÷ floor"],
+        md_table(["vertex set", "kernel", "node runs", "kernel / vertex", "floor", "floor / vertex",
+                  "kernel ÷ floor"],
                  floor_rows)])
 
 
