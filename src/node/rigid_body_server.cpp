@@ -1,5 +1,7 @@
 #include "rigid_body_server.h"
 
+#include "bounded_request.h"
+
 #include <algorithm>
 #include <cstring>
 
@@ -96,6 +98,29 @@ void appendMatrix(const Matrix& matrix, std::vector<double>& out)
       out.push_back(matrix(r, c));
 }
 
+// Advertises `handler` for the service Srv with bounded request decoding
+// (bounded_request.h): a request refused there gets success=false and the
+// refusal, and never reaches the handler.
+template <typename Srv, typename Server>
+ros::ServiceServer advertiseBounded(ros::NodeHandle& nh, const std::string& name,
+                                    bool (Server::*handler)(typename Srv::Request&, typename Srv::Response&),
+                                    Server* server)
+{
+  using Bounded = BoundedRequest<typename Srv::Request>;
+  using Response = typename Srv::Response;
+  const boost::function<bool(Bounded&, Response&)> callback = [server, handler, name](Bounded& bounded,
+                                                                                      Response& response) {
+    if (bounded.refusal.empty())
+      return (server->*handler)(bounded.request, response);
+    response = Response();
+    response.success = false;
+    response.message = bounded.refusal;
+    ROS_DEBUG_STREAM(name << ": refused: " << bounded.refusal);
+    return true;
+  };
+  return nh.advertiseService<Bounded, Response>(name, callback);
+}
+
 std::vector<NamedState> toNamedStates(const std::vector<BodyState>& states)
 {
   std::vector<NamedState> named;
@@ -124,8 +149,7 @@ RigidBodyServer::RigidBodyServer(ros::NodeHandle& nh, ros::NodeHandle& private_n
   const bool benchmark_services = private_nh.param("benchmark_services", false);
 #define DRB_ADVERTISE(name, srv_type, handler, python_method, cpp_method, benchmark_only)                              \
   if (!(benchmark_only) || benchmark_services)                                                                         \
-    services_.push_back(private_nh.advertiseService<RigidBodyServer, srv_type::Request, srv_type::Response>(       \
-        #name, &RigidBodyServer::handler, this));
+    services_.push_back(advertiseBounded<srv_type>(private_nh, #name, &RigidBodyServer::handler, this));
   DIFF_RIGID_BODY_SERVICES(DRB_ADVERTISE)
 #undef DRB_ADVERTISE
   // After the services: a client that sees ~set_states subscribed sees every service.
