@@ -49,34 +49,6 @@ inline ByCoordinate byCoordinate(const VertexColumns<double>& columns)
 {
   return { columns.col(0).data(), columns.col(1).data(), columns.col(2).data() };
 }
-
-// Former names of the by-coordinate kernels, kept for bench/memory_floors.h
-// (their callers move to addGradientSums*(ByCoordinate, ByVertex, ...)).
-inline void addVertexGradientsScalar(const double* x, const double* y, const double* z, const double* g,
-                                     std::size_t begin, std::size_t end, GradientSums12& sums)
-{
-  addGradientSumsScalar(ByCoordinate{ x, y, z }, ByVertex{ g }, begin, end, sums);
-}
-#if defined(DRB_VERTEX_KERNELS_AVX2)
-inline std::size_t addVertexGradientsAvx512(const double* x, const double* y, const double* z, const double* g,
-                                            std::size_t count, GradientSums12& sums)
-{
-  return addGradientSumsAvx512(ByCoordinate{ x, y, z }, ByVertex{ g }, count, sums);
-}
-inline std::size_t addVertexGradientsAvx2(const double* x, const double* y, const double* z, const double* g,
-                                          std::size_t count, GradientSums12& sums)
-{
-  return addGradientSumsAvx2(ByCoordinate{ x, y, z }, ByVertex{ g }, count, sums);
-}
-#endif
-inline VertexGradientSums<double> toVertexGradientSums(const GradientSums12* partial, std::size_t chunks)
-{
-  VertexGradientSums<double> sums;
-  for (std::size_t c = 0; c < chunks; ++c)
-    for (int k = 0; k < 12; ++k)
-      (k < 9 ? sums.W(k / 3, k % 3) : sums.force[k - 9]) += partial[c][k];
-  return sums;
-}
 }  // namespace detail
 
 /// W = sum_i g_i p0_i^T and force = sum_i g_i over all vertices, on up to
