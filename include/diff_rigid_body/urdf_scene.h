@@ -105,9 +105,6 @@ struct Scene
   /// Implausible but loadable findings, each naming the link, joint or body:
   /// massless links, implausible inertia, a body that starts at gimbal lock.
   std::vector<std::string> warnings;
-
-  /// Index of the body called `name`, or -1.
-  int findBody(const std::string& name) const;
 };
 
 /// Builds the scene. Throws SceneDescriptionError (malformed XML, unknown

@@ -84,7 +84,7 @@ SceneQueries::SceneQueries(Scene scene) : scene_(std::move(scene))
     vertex_columns_.emplace_back(body.body.vertices.transpose());
   }
   for (std::size_t i = 0; i < scene_.bodies.size(); ++i)
-    body_index_.emplace(scene_.bodies[i].body.name, i);  // the first of equal names, as Scene::findBody
+    body_index_.emplace(scene_.bodies[i].body.name, i);  // the first of equal names
 }
 
 SceneState SceneQueries::initialState() const

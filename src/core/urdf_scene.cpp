@@ -317,14 +317,6 @@ private:
 
 }  // namespace
 
-int Scene::findBody(const std::string& name) const
-{
-  for (std::size_t i = 0; i < bodies.size(); ++i)
-    if (bodies[i].body.name == name)
-      return static_cast<int>(i);
-  return -1;
-}
-
 Scene loadSceneFromUrdf(const std::string& urdf_xml, const SceneOptions& options)
 {
   return SceneBuilder(urdf_xml, options).build();

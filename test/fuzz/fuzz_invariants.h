@@ -32,6 +32,16 @@ inline void requireAllFinite(const double* values, std::size_t count, const std:
       violated(what + "[" + std::to_string(i) + "] is not finite");
 }
 
+/// Index of the first body called `name` in `scene`, or -1 (a reference
+/// lookup, independent of SceneQueries' hash map).
+inline int findBody(const drb::Scene& scene, const std::string& name)
+{
+  for (std::size_t i = 0; i < scene.bodies.size(); ++i)
+    if (scene.bodies[i].body.name == name)
+      return static_cast<int>(i);
+  return -1;
+}
+
 /// Every loaded scene: at least one body; finite mass >= 0, finite
 /// symmetric inertia, finite COM, vertices and initial state; finite static
 /// link poses.
@@ -51,7 +61,7 @@ inline void requireValidScene(const drb::Scene& scene)
     require(scene_body.initial_state.allFinite(), where + "initial state not finite");
     for (const drb::LinkInBody& link : scene_body.links)
       require(link.pose_in_body_link.matrix().allFinite(), where + "link pose not finite");
-    require(scene.findBody(body.name) >= 0, where + "not found by name");
+    require(findBody(scene, body.name) >= 0, where + "not found by name");
   }
   for (const drb::StaticLink& link : scene.static_links)
     require(link.pose_in_fixed_frame.matrix().allFinite(), "static link '" + link.name + "': pose not finite");

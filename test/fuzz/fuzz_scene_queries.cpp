@@ -147,7 +147,7 @@ void setState(FuzzedDataProvider& in, drb::SceneState& current)
   std::vector<bool> updated(current.size(), false);
   for (const drb::NamedState& update : updates)
   {
-    const int index = queries().scene().findBody(update.name);
+    const int index = drb_fuzz::findBody(queries().scene(), update.name);
     require(index >= 0, "set_state accepted an unknown body");
     require(!updated[index], "set_state accepted a repeated body");
     updated[index] = true;
@@ -242,7 +242,7 @@ void getVertexJacobians(FuzzedDataProvider& in, const drb::SceneState& current)
             "get_vertex_jacobians: a refused request wrote its outputs");
     return;
   }
-  const int index = queries().scene().findBody(body);
+  const int index = drb_fuzz::findBody(queries().scene(), body);
   require(index >= 0, "get_vertex_jacobians accepted an unknown body");
   const std::size_t count =
       vertices.empty() ? static_cast<std::size_t>(queries().body(index).vertices.cols()) : vertices.size();
@@ -272,7 +272,7 @@ void vertexRotationJacobians(FuzzedDataProvider& in, const drb::SceneState& curr
             "get_vertex_jacobians_compact: a refused request wrote its outputs");
     return;
   }
-  const int index = queries().scene().findBody(body);
+  const int index = drb_fuzz::findBody(queries().scene(), body);
   require(index >= 0, "get_vertex_jacobians_compact accepted an unknown body");
   const std::size_t count =
       vertices.empty() ? static_cast<std::size_t>(queries().body(index).vertices.cols()) : vertices.size();
@@ -289,7 +289,7 @@ void backprop(FuzzedDataProvider& in, const drb::SceneState& current)
   const std::vector<std::uint32_t> vertices = fuzzedVertices(in);
   const std::vector<double> q = fuzzedQ(in);
   std::vector<double> gradients;
-  const int index = queries().scene().findBody(body);
+  const int index = drb_fuzz::findBody(queries().scene(), body);
   if (index >= 0 && in.ConsumeBool())
   {
     // The expected size, so that the values are what is tested.
