@@ -211,30 +211,15 @@ struct Serializer<diff_rigid_body::BoundedRequest<Request>>
 
 // Same identity as the wrapped request, so the service's md5sum and types
 // are those of the generated srv.
-namespace message_traits
-{
-template <typename Request>
-struct MD5Sum<diff_rigid_body::BoundedRequest<Request>> : MD5Sum<Request>
-{
-};
-template <typename Request>
-struct DataType<diff_rigid_body::BoundedRequest<Request>> : DataType<Request>
-{
-};
-template <typename Request>
-struct Definition<diff_rigid_body::BoundedRequest<Request>> : Definition<Request>
-{
-};
-}  // namespace message_traits
-namespace service_traits
-{
-template <typename Request>
-struct MD5Sum<diff_rigid_body::BoundedRequest<Request>> : MD5Sum<Request>
-{
-};
-template <typename Request>
-struct DataType<diff_rigid_body::BoundedRequest<Request>> : DataType<Request>
-{
-};
-}  // namespace service_traits
+#define DRB_TRAIT_OF_THE_WRAPPED_REQUEST(traits, Trait)                                                             \
+  template <typename Request>                                                                                      \
+  struct traits::Trait<diff_rigid_body::BoundedRequest<Request>> : traits::Trait<Request>                          \
+  {                                                                                                                \
+  };
+DRB_TRAIT_OF_THE_WRAPPED_REQUEST(message_traits, MD5Sum)
+DRB_TRAIT_OF_THE_WRAPPED_REQUEST(message_traits, DataType)
+DRB_TRAIT_OF_THE_WRAPPED_REQUEST(message_traits, Definition)
+DRB_TRAIT_OF_THE_WRAPPED_REQUEST(service_traits, MD5Sum)
+DRB_TRAIT_OF_THE_WRAPPED_REQUEST(service_traits, DataType)
+#undef DRB_TRAIT_OF_THE_WRAPPED_REQUEST
 }  // namespace ros
