@@ -21,6 +21,7 @@
 #include "diff_rigid_body/triangle_mesh.h"
 #include "diff_rigid_body/vertex_columns.h"
 #include "diff_rigid_body/vertex_jacobian.h"
+#include "../test/support/meshes.h"  // readObj, shared with the tests
 
 namespace drb_bench
 {
@@ -222,47 +223,6 @@ inline drb::TriangleMesh bumpySphere(std::size_t target)
   return mesh;
 }
 
-/// Minimal OBJ reader (v and f lines; polygons fanned). false if unreadable.
-inline bool readObj(const std::string& path, drb::TriangleMesh* mesh)
-{
-  std::ifstream in(path);
-  if (!in)
-    return false;
-  std::vector<Eigen::Vector3d> v;
-  std::string line;
-  mesh->triangles.clear();
-  while (std::getline(in, line))
-  {
-    std::istringstream tokens(line);
-    std::string tag;
-    tokens >> tag;
-    if (tag == "v")
-    {
-      Eigen::Vector3d p;
-      tokens >> p.x() >> p.y() >> p.z();
-      v.push_back(p);
-    }
-    else if (tag == "f")
-    {
-      std::vector<std::uint32_t> polygon;
-      std::string corner;
-      while (tokens >> corner)
-      {
-        const long index = std::stol(corner.substr(0, corner.find('/')));
-        polygon.push_back(static_cast<std::uint32_t>(index > 0 ? index - 1 : static_cast<long>(v.size()) + index));
-      }
-      for (std::size_t k = 2; k < polygon.size(); ++k)
-        mesh->triangles.push_back({ polygon[0], polygon[k - 1], polygon[k] });
-    }
-  }
-  if (v.empty() || mesh->triangles.empty())
-    return false;
-  mesh->vertices.resize(3, static_cast<Eigen::Index>(v.size()));
-  for (std::size_t i = 0; i < v.size(); ++i)
-    mesh->vertices.col(static_cast<Eigen::Index>(i)) = v[i];
-  return true;
-}
-
 /// A named mesh read from this repository's test/meshes/stanford (the
 /// Stanford bunny or armadillo; see the README.md there).
 struct NamedMesh
@@ -283,7 +243,7 @@ inline NamedMesh stanfordMesh(const std::string& name)
 #endif
   NamedMesh out;
   out.name = name;
-  if (!readObj(path, &out.mesh))
+  if (!drb_test::readObj(path, &out.mesh))
   {
     std::fprintf(stderr, "benchmark mesh %s is missing or unreadable\n", path.c_str());
     std::exit(2);
