@@ -1,0 +1,115 @@
+"""PyTorch autograd functions over a :class:`~diff_rigid_body.client.RigidBodyClient`.
+
+Shapes follow torch conventions, with a leading batch axis of K
+configurations (q = (phi, theta, psi, tx, ty, tz), float64 tensors on the CPU):
+
+=======================================  ==========================================
+``vertex_positions(client, body, q)``    q (K, 6) -> p (K, N, 3) [m]; q (6,) -> (N, 3)
+``mass_matrix(client, body, q)``         q (K, 6) -> M (K, 6, 6); q (6,) -> (6, 6)
+``kinetic_energy(client, body, q, qd)``  q, qdot (K, 6) -> E (K,) [J]; (6,) -> ()
+=======================================  ==========================================
+
+Each forward pass is one service call for all K configurations
+(``get_vertex_jacobians`` or ``get_mass_matrix`` with derivatives); the
+backward pass of :func:`vertex_positions` is one ``backprop`` call with
+grad_output as dL/dp (J is never formed), that of :func:`mass_matrix` is
+dL/dq_j = sum_ab grad_M[a, b] dM[a, b]/dq_j from the dM of the forward call.
+``per_frame=True`` makes one call per configuration instead (same numbers:
+for comparisons). The node's state is never changed. First derivatives only.
+"""
+import numpy as np
+import torch
+from torch.autograd.function import once_differentiable
+
+__all__ = ['vertex_positions', 'mass_matrix', 'kinetic_energy', 'positions_batch', 'backprop_batch']
+
+
+def _numpy(tensor):
+    return tensor.detach().cpu().numpy().astype(np.float64)
+
+
+def positions_batch(client, body, q, vertices=None, per_frame=False):
+    """positions (K, N, 3) of ``body``'s ``vertices`` at the K rows of ``q`` (K, 6)."""
+    if per_frame:
+        return np.stack([client.positions(body, qk, vertices) for qk in q])
+    if len(q) == 1:
+        return client.positions(body, q[0], vertices)[None]
+    return np.asarray(client.positions(body, q, vertices)).reshape(len(q), -1, 3)
+
+
+def backprop_batch(client, body, gradients, q, vertices=None, per_frame=False):
+    """dL/dq (K, 6) from dL/dp ``gradients`` (K, N, 3) at ``q`` (K, 6)."""
+    if per_frame:
+        return np.stack([client.backprop(body, g, qk, vertices) for g, qk in zip(gradients, q)])
+    if len(q) == 1:
+        return np.asarray(client.backprop(body, gradients[0], q[0], vertices))[None]
+    return np.asarray(client.backprop(body, gradients, q, vertices)).reshape(len(q), 6)
+
+
+class _VertexPositions(torch.autograd.Function):
+
+    @staticmethod
+    def forward(ctx, q, client, body, vertices, per_frame):
+        ctx.client, ctx.body, ctx.vertices, ctx.per_frame = client, body, vertices, per_frame
+        ctx.q = _numpy(q)
+        return torch.from_numpy(positions_batch(client, body, ctx.q, vertices, per_frame).copy()).to(q.dtype)
+
+    @staticmethod
+    @once_differentiable
+    def backward(ctx, grad_positions):
+        gradient = backprop_batch(ctx.client, ctx.body, _numpy(grad_positions), ctx.q, ctx.vertices, ctx.per_frame)
+        return torch.from_numpy(np.array(gradient)).to(grad_positions.dtype), None, None, None, None
+
+
+class _MassMatrix(torch.autograd.Function):
+
+    @staticmethod
+    def forward(ctx, q, client, body, per_frame):
+        q_np = _numpy(q)
+        if per_frame:
+            answers = [client.mass_matrix([body], qk[None], derivatives=True) for qk in q_np]
+            M = np.stack([a.M[0] for a in answers])
+            dM = np.stack([a.dM[0] for a in answers])
+        else:
+            answer = client.mass_matrix([body], q_np[:, None, :], derivatives=True)
+            M, dM = answer.M[:, 0], answer.dM[:, 0]  # (K, 6, 6), (K, 6, 6, 6): dM[k, j] = dM/dq_j
+        ctx.dM = np.array(dM)
+        return torch.from_numpy(np.array(M)).to(q.dtype)
+
+    @staticmethod
+    @once_differentiable
+    def backward(ctx, grad_M):
+        gradient = np.einsum('kab,kjab->kj', _numpy(grad_M), ctx.dM)
+        return torch.from_numpy(gradient).to(grad_M.dtype), None, None, None
+
+
+def _batched(q):
+    """(q as (K, 6), whether q was a single (6,) configuration)."""
+    if q.dim() == 1:
+        return q.reshape(1, 6), True
+    if q.dim() != 2 or q.shape[1] != 6:
+        raise ValueError('q must have shape (6,) or (K, 6), not %s' % (tuple(q.shape),))
+    return q, False
+
+
+def vertex_positions(client, body, q, vertices=None, per_frame=False):
+    """Positions [m] of ``body``'s ``vertices`` (None = all): (K, N, 3) for q
+    (K, 6), (N, 3) for q (6,). Differentiable in q (backward: ``backprop``)."""
+    q2, single = _batched(q)
+    p = _VertexPositions.apply(q2, client, body, vertices, per_frame)
+    return p[0] if single else p
+
+
+def mass_matrix(client, body, q, per_frame=False):
+    """M(q) of ``body``: (K, 6, 6) for q (K, 6), (6, 6) for q (6,).
+    Differentiable in q (backward from dM/dq of the same call)."""
+    q2, single = _batched(q)
+    M = _MassMatrix.apply(q2, client, body, per_frame)
+    return M[0] if single else M
+
+
+def kinetic_energy(client, body, q, qdot, per_frame=False):
+    """E = 1/2 qdot^T M(q) qdot [J] per configuration: (K,) for (K, 6), () for (6,).
+    Differentiable in q and qdot."""
+    M = mass_matrix(client, body, q, per_frame)
+    return 0.5 * torch.einsum('...a,...ab,...b->...', qdot, M, qdot)
