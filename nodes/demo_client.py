@@ -4,7 +4,8 @@ against a running rigid_body_server (the default scene).
 
 1. Pose fitting: target vertex positions of one body at a hidden pose (with
    and without noise); recover q from a start 30 deg and 0.2 m away by
-   Gauss-Newton (get_vertex_jacobians) and by L-BFGS (backprop).
+   Gauss-Newton (get_vertex_jacobians), by L-BFGS (backprop) and by SciPy's
+   least_squares (get_vertex_jacobians as jac).
 2. Kinetic energy E = 1/2 qdot^T M(q) qdot along a K-configuration
    trajectory: one batched get_mass_matrix call against K calls.
 
@@ -22,11 +23,15 @@ import numpy as np
 import rospy
 
 from diff_rigid_body.client import DiffRigidBodyError, RigidBodyClient
-from diff_rigid_body import pose_fitting, trajectory_energy
+from diff_rigid_body import pose_fitting, trajectory_energy, trajectory_fitting
 
 Q_HIDDEN = np.array([0.3, -0.4, 1.1, 0.05, -0.1, 0.6])  # the pose to recover
 EXACT_ANGLE, EXACT_POSITION = 1e-8, 1e-8  # [rad], [m]: noise-free fit vs Q_HIDDEN
 AGREE_ANGLE, AGREE_POSITION = 1e-6, 1e-6  # [rad], [m]: noisy fits, one vs the other
+# Trajectory: q0 (rad, m) and qdot0 (rad/s, m/s) of the toss to recover.
+X_HIDDEN = np.array([0.2, -0.3, 0.5, 0.0, 0.0, 1.0, 1.5, 0.8, -1.0, 0.5, -0.3, 4.0])
+AGREE_TRAJECTORY = 1e-6   # max |x_torch - x_least_squares|
+NOISE_SIGMAS = 5.0        # max |x_fit - x_hidden| / standard deviation of the estimate
 
 
 def print_scene(client):
@@ -51,7 +56,8 @@ def pose_fitting_example(client, body, noises):
         print('   start: %.1f deg and %.3f m away (noise %g m)' % (np.degrees(angle), distance, noise))
         fitted = []
         for label, fit in (('Gauss-Newton (jacobians)', pose_fitting.fit_gauss_newton),
-                           ('L-BFGS (backprop)', pose_fitting.fit_lbfgs)):
+                           ('L-BFGS (backprop)', pose_fitting.fit_lbfgs),
+                           ('least_squares (jacobians)', pose_fitting.fit_least_squares)):
             result = fit(client, body, target, q_start)
             angle, distance = pose_fitting.pose_error(result.q, Q_HIDDEN)
             print('   %-26s %7g %6d %6d %10.3e m %9.3e rad %11.3e m %7.3f s%s' % (
@@ -64,10 +70,11 @@ def pose_fitting_example(client, body, noises):
                                 % (label, angle, distance, EXACT_ANGLE, EXACT_POSITION))
             fitted.append(result.q)
         if noise != 0.0:
-            angle, distance = pose_fitting.pose_error(fitted[0], fitted[1])
-            print('   the two fits differ by %.3e rad and %.3e m' % (angle, distance))
+            errors = [pose_fitting.pose_error(q, fitted[0]) for q in fitted[1:]]
+            angle, distance = max(e[0] for e in errors), max(e[1] for e in errors)
+            print('   the fits differ from Gauss-Newton by at most %.3e rad and %.3e m' % (angle, distance))
             if not (angle < AGREE_ANGLE and distance < AGREE_POSITION):
-                failures.append('noise %g m: the two fits differ by %.3e rad and %.3e m (tolerance %g rad, %g m)'
+                failures.append('noise %g m: the fits differ by %.3e rad and %.3e m (tolerance %g rad, %g m)'
                                 % (noise, angle, distance, AGREE_ANGLE, AGREE_POSITION))
     return failures
 
@@ -91,12 +98,55 @@ def trajectory_example(client, bodies, count):
         np.abs(batched - oracle) / np.abs(oracle)))
 
 
+def trajectory_fitting_example(client, body, noise, frames):
+    """Fits a toss; prints one row per solver; returns the list of failures."""
+    times = np.arange(frames) / 100.0  # 100 frames per second
+    vertices = np.linspace(0, client.bodies().vertex_counts[0] - 1, 64).astype(np.uint32)
+    per_frame = not trajectory_fitting.batched_calls_supported(client, body)
+    observed, x_start = trajectory_fitting.make_problem(client, body, X_HIDDEN, times, vertices, noise, seed=5,
+                                                        per_frame=per_frame)
+    sigma = trajectory_fitting.standard_errors(client, body, X_HIDDEN, times, vertices, noise, per_frame)
+    print('\n3. Trajectory fitting of a tossed %r: q0, qdot0 from T = %d frames (%.2f s) of %d vertices, '
+          'noise %g m%s' % (body, frames, times[-1], len(vertices), noise,
+                            ' (PER-FRAME calls: the node takes no batch)' if per_frame else ''))
+    print('   start off by %.2e rad, %.2e m, %.2e rad/s, %.2e m/s; standard deviations of the estimate up to '
+          '%.1e rad, %.1e m, %.1e rad/s, %.1e m/s' % (trajectory_fitting.errors(x_start, X_HIDDEN) + tuple(
+              sigma.reshape(4, 3).max(axis=1))))
+    print('   %-22s %6s %6s %6s %10s %11s %12s %10s %12s %12s %9s' % (
+        'solver', 'iters', 'evals', 'calls', 'per-frame', 'rms resid', 'angles', 'position', 'ang. rates',
+        'velocity', 'time'))
+    failures, fitted = [], []
+    for label, fit in (('torch LBFGS (backprop)', trajectory_fitting.fit_torch),
+                       ('least_squares (J)', trajectory_fitting.fit_least_squares)):
+        r = fit(client, body, observed, times, x_start, vertices, per_frame=per_frame)
+        e = trajectory_fitting.errors(r.x, X_HIDDEN)
+        print('   %-22s %6d %6d %6d %10d %8.3e m %6.2e rad %6.2e m %6.2e r/s %6.2e m/s %7.3f s%s' % (
+            (label, r.iterations, r.evaluations, r.calls, r.per_frame_calls, r.residual_rms) + e + (
+                r.wall_time, '' if r.converged else '  (NOT CONVERGED: %s)' % r.reason)))
+        sigmas = np.max(np.abs(r.x - X_HIDDEN) / sigma)
+        if not r.converged:
+            failures.append('trajectory, %s: not converged (%s)' % (label, r.reason))
+        elif sigmas > NOISE_SIGMAS:
+            failures.append('trajectory, %s: %.1f standard deviations from the hidden truth (at most %g)'
+                            % (label, sigmas, NOISE_SIGMAS))
+        fitted.append(r)
+    print('   round trips saved by batched calls: %d of %d' % tuple(
+        (sum(r.per_frame_calls - r.calls for r in fitted), sum(r.per_frame_calls for r in fitted))))
+    difference = np.max(np.abs(fitted[0].x - fitted[1].x))
+    print('   the two fits differ by %.2e (max over q0, qdot0); errors vs truth at most %.1f standard deviations'
+          % (difference, max(np.max(np.abs(r.x - X_HIDDEN) / sigma) for r in fitted)))
+    if difference > AGREE_TRAJECTORY:
+        failures.append('trajectory: the two fits differ by %.2e (at most %g)' % (difference, AGREE_TRAJECTORY))
+    return failures
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument('--server', default='rigid_body_server')
     parser.add_argument('--body', default='knot', help='body to fit (default: knot)')
     parser.add_argument('--noise', type=float, default=1e-3, help='[m] noise of the noisy fit (default: 1 mm)')
     parser.add_argument('--configurations', type=int, default=1000, help='K (default: 1000)')
+    parser.add_argument('--frames', type=int, default=120, help='T of the trajectory fit (default: 120)')
     args = parser.parse_args(rospy.myargv()[1:])
     rospy.init_node('demo_client', anonymous=True)
 
@@ -104,6 +154,7 @@ def main():
     bodies = print_scene(client)
     failures = pose_fitting_example(client, args.body, [0.0, args.noise])
     trajectory_example(client, bodies, args.configurations)
+    failures += trajectory_fitting_example(client, 'knot', args.noise, args.frames)
     try:
         client.vertex_jacobians('no_such_body')
     except DiffRigidBodyError as e:

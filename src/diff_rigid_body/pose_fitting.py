@@ -10,6 +10,9 @@ with q passed in each request (the node's state is never changed):
 * :func:`fit_lbfgs`: L-BFGS on L with dL/dq from ``backprop`` (a
   vector-Jacobian product: J is never formed) and an Armijo backtracking line
   search. Positions come from ``get_vertex_jacobians``.
+* :func:`fit_least_squares`: scipy.optimize.least_squares (trust region
+  reflective) with the residuals' Jacobian J from ``get_vertex_jacobians`` as
+  ``jac`` (one call per evaluation: its J is reused when SciPy asks for it).
 
 The small rotation helpers below only build test poses and measure errors:
 R(q) = Rz(psi) Ry(theta) Rx(phi), as in the node.
@@ -18,8 +21,9 @@ import collections
 import time
 
 import numpy as np
+import scipy.optimize
 
-__all__ = ['FitResult', 'fit_gauss_newton', 'fit_lbfgs', 'rpy_to_matrix', 'matrix_to_rpy', 'perturbed_pose',
+__all__ = ['FitResult', 'fit_gauss_newton', 'fit_lbfgs', 'fit_least_squares', 'rpy_to_matrix', 'matrix_to_rpy', 'perturbed_pose',
            'pose_error', 'make_problem']
 
 #: q (6,), iterations, evaluations (service calls), cost L [m^2], residual_rms
@@ -214,3 +218,29 @@ def fit_lbfgs(client, body, target, q0, vertices=None, memory=10, max_iterations
         history.append(cost)
     return _result(q, max_iterations, evaluations[0], cost, start, False, (gradient0, gradient), 'iteration limit',
                    history)
+
+
+def fit_least_squares(client, body, target, q0, vertices=None, max_evaluations=100, tolerance=1e-15):
+    """Fits q like :func:`fit_gauss_newton`, by ``scipy.optimize.least_squares``
+    on the residuals p - target (3N) with ``jac`` = J (3N, 6) of the same
+    ``get_vertex_jacobians`` call. Stops on SciPy's xtol/ftol/gtol =
+    ``tolerance`` or after ``max_evaluations``.
+    """
+    start = time.perf_counter()
+    target = np.asarray(target, dtype=float).reshape(-1, 3)
+    last = {}
+
+    def evaluate(q):
+        if last.get('q') is None or not np.array_equal(last['q'], q):
+            p, J = client.vertex_jacobians(body, q, vertices)
+            last.update(q=np.array(q), r=(p - target).ravel(), J=J.reshape(-1, 6), calls=last.get('calls', 0) + 1)
+        return last
+
+    gradient0 = evaluate(q0)['J'].T.dot(last['r']) / len(target)
+    result = scipy.optimize.least_squares(lambda q: evaluate(q)['r'], np.array(q0, dtype=float),
+                                          jac=lambda q: evaluate(q)['J'], method='trf', xtol=tolerance,
+                                          ftol=tolerance, gtol=tolerance, max_nfev=max_evaluations)
+    r = evaluate(result.x)['r'].reshape(-1, 3)
+    gradients = (gradient0, last['J'].T.dot(last['r']) / len(target))
+    return _result(result.x, result.njev, last['calls'], _cost(r), start, result.status > 0, gradients,
+                   result.message.rstrip('.'), [])

@@ -5,7 +5,9 @@ node on the default scene (clients_python.test).
 - shapes and axis order of every answer (dM[i, j] = dM/dq_j of body i,
   checked by central differences of M);
 - success=false raises DiffRigidBodyError with the node's message;
-- both pose fits recover a hidden pose within 1e-8 without noise;
+- the three pose fits recover a hidden pose within 1e-8 without noise;
+- both trajectory fits (torch LBFGS, SciPy least_squares) of a toss land
+  within 5 standard deviations of the hidden q0, qdot0 with 1 mm noise;
 - batched and per-call trajectory energies agree, and agree with
   1/2 w^T I w + 1/2 m v^2 from get_bodies alone;
 - persistent connections survive a restart of the node.
@@ -22,7 +24,7 @@ import rospy
 import rostest
 
 from diff_rigid_body.client import DiffRigidBodyError, RigidBodyClient
-from diff_rigid_body import pose_fitting, trajectory_energy
+from diff_rigid_body import pose_fitting, trajectory_energy, trajectory_fitting
 
 PKG = 'diff_rigid_body'
 SERVER = '/rigid_body_server'
@@ -31,6 +33,7 @@ ENERGY_TOLERANCE = 1e-12    # relative: batched against per-call energies
 ORACLE_TOLERANCE = 1e-10    # relative: against 1/2 w^T I w + 1/2 m v^2
 FD_TOLERANCE = 1e-7         # dM/dq against central differences, relative to max |M|
 Q_HIDDEN = np.array([0.3, -0.4, 1.1, 0.05, -0.1, 0.6])
+X_HIDDEN = np.array([0.2, -0.3, 0.5, 0.0, 0.0, 1.0, 1.5, 0.8, -1.0, 0.5, -0.3, 4.0])  # q0, qdot0 of a toss
 
 
 class PythonClient(unittest.TestCase):
@@ -123,6 +126,27 @@ class PythonClient(unittest.TestCase):
 
     def test_lbfgs_with_backprop_recovers_the_hidden_pose(self):
         self.check_fit(pose_fitting.fit_lbfgs)
+
+    def test_scipy_least_squares_recovers_the_hidden_pose(self):
+        result = self.check_fit(pose_fitting.fit_least_squares)
+        self.assertLessEqual(result.iterations, 15)
+
+    def test_trajectory_fits_reach_the_noise_level(self):
+        # A toss of T = 100 frames of 64 knot vertices with 1 mm noise; both
+        # solvers, one call for all frames per evaluation.
+        times, noise = np.arange(100) / 100.0, 1e-3
+        vertices = np.linspace(0, 4095, 64).astype(np.uint32)
+        observed, x_start = trajectory_fitting.make_problem(self.client, 'knot', X_HIDDEN, times, vertices, noise,
+                                                            seed=11)
+        sigma = trajectory_fitting.standard_errors(self.client, 'knot', X_HIDDEN, times, vertices, noise)
+        fits = [fit(self.client, 'knot', observed, times, x_start, vertices)
+                for fit in (trajectory_fitting.fit_torch, trajectory_fitting.fit_least_squares)]
+        for fit in fits:
+            self.assertTrue(fit.converged, fit.reason)
+            self.assertLess(np.max(np.abs(fit.x - X_HIDDEN) / sigma), 5.0, 'x = %r, sigma = %r' % (fit.x, sigma))
+            self.assertAlmostEqual(fit.residual_rms / noise, 1.0, delta=0.05, msg='rms residual / noise')
+            self.assertEqual(fit.per_frame_calls, 100 * fit.calls, 'one call per evaluation for all 100 frames')
+        np.testing.assert_allclose(fits[0].x, fits[1].x, atol=1e-6, err_msg='torch LBFGS vs least_squares')
 
     def test_batched_and_per_call_energies_agree(self):
         bodies = self.client.bodies()
