@@ -255,6 +255,9 @@ def main():
     scene_path = os.path.join(args.results, "scene.json")
     if os.path.exists(scene_path):
         parts.append(section_scene(load(scene_path)))
+    client_path = os.path.join(args.results, "client_trajectory.md")  # written by bench/client_trajectory.py
+    if os.path.exists(client_path):
+        parts.append(open(client_path).read().strip())
     plot_kernels(k, acc, args.docs)
 
     info = machine(args.workspace, kernels_json, args.repo, args.results)

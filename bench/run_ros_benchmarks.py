@@ -8,8 +8,10 @@ Starts its own roscore on a free loopback port, then
   * scene scale: rigid_body_server on generated URDFs of 1, 100 and 10,000
     bodies: load time, resident memory (VmRSS), and the CPU the node uses
     publishing tf at 50 Hz (from /proc/<pid>/stat), with no tf subscriber and
-    with one (drb_bench_service tf_sink).
-Writes <out>/service.json and <out>/scene.json. Everything it starts is
+    with one (drb_bench_service tf_sink);
+  * client trajectories: bench/client_trajectory.py (PyTorch through the
+    Python client, batched against per-frame calls) on the default scene.
+Writes <out>/service.json, <out>/scene.json and <out>/client_trajectory.md. Everything it starts is
 stopped on exit. Run by scripts/bench; needs the ROS environment sourced.
 """
 import argparse
@@ -256,14 +258,32 @@ def run_scene(args, env, master):
         json.dump({"publish_rate_hz": 50.0, "cpu_window_s": args.cpu_seconds, "scenes": results}, f, indent=1)
 
 
+def run_client_trajectory(args, env, master):
+    """bench/client_trajectory.py (PyTorch through the Python client) against the node on the default scene."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    urdf = os.path.join(here, "..", "urdf", "demo_scene.urdf")
+    node = start_node(args, env, urdf, os.path.join(args.out, "node_client_trajectory.log"))
+    try:
+        wait_for(lambda: master.has_service("/rigid_body_server/backprop"), 300, "the node", node)
+        log("client trajectories: node up; running bench/client_trajectory.py")
+        client = subprocess.run([sys.executable, os.path.join(here, "client_trajectory.py"), "--server",
+                                 "/rigid_body_server", "--output", os.path.join(args.out, "client_trajectory.md")],
+                                env=env)
+        if client.returncode != 0:
+            raise RuntimeError(f"client_trajectory.py exited with {client.returncode}")
+    finally:
+        node.stop()
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--bin", required=True, help="folder of rigid_body_server and drb_bench_service")
     parser.add_argument("--out", required=True)
     parser.add_argument("--budget", type=float, default=0.5, help="seconds per service measurement")
     parser.add_argument("--cpu-seconds", type=float, default=3.0)
-    parser.add_argument("--only", choices=["services", "scene"], default=None,
-                        help="run only the service-level part or only the scene-scale part (default: both)")
+    parser.add_argument("--only", choices=["services", "scene", "client"], default=None,
+                        help="run only the service-level part, the scene-scale part or the PyTorch client "
+                             "trajectories (default: all)")
     args = parser.parse_args()
     os.makedirs(args.out, exist_ok=True)
 
@@ -283,6 +303,8 @@ def main():
             run_services(args, env, master)
         if args.only in (None, "scene"):
             run_scene(args, env, master)
+        if args.only in (None, "client"):
+            run_client_trajectory(args, env, master)
     finally:
         core.stop()
 

@@ -10,7 +10,8 @@ configurations (q = (phi, theta, psi, tx, ty, tz), float64 tensors on the CPU):
 =======================================  ==========================================
 
 Each forward pass is one service call for all K configurations
-(``get_vertex_jacobians`` or ``get_mass_matrix`` with derivatives); the
+(``get_vertex_jacobians_compact`` with positions_only, or ``get_mass_matrix``
+with derivatives); the
 backward pass of :func:`vertex_positions` is one ``backprop`` call with
 grad_output as dL/dp (J is never formed), that of :func:`mass_matrix` is
 dL/dq_j = sum_ab grad_M[a, b] dM[a, b]/dq_j from the dM of the forward call.
@@ -28,13 +29,18 @@ def _numpy(tensor):
     return tensor.detach().cpu().numpy().astype(np.float64)
 
 
+def _positions(client, body, q, vertices):
+    """Positions only (``get_vertex_jacobians_compact`` with positions_only: no J on the wire)."""
+    return client.vertex_jacobians_compact(body, q, vertices, positions_only=True)[0]
+
+
 def positions_batch(client, body, q, vertices=None, per_frame=False):
     """positions (K, N, 3) of ``body``'s ``vertices`` at the K rows of ``q`` (K, 6)."""
     if per_frame:
-        return np.stack([client.positions(body, qk, vertices) for qk in q])
+        return np.stack([_positions(client, body, qk, vertices) for qk in q])
     if len(q) == 1:
-        return client.positions(body, q[0], vertices)[None]
-    return np.asarray(client.positions(body, q, vertices)).reshape(len(q), -1, 3)
+        return _positions(client, body, q[0], vertices)[None]
+    return np.asarray(_positions(client, body, q, vertices)).reshape(len(q), -1, 3)
 
 
 def backprop_batch(client, body, gradients, q, vertices=None, per_frame=False):
