@@ -103,6 +103,11 @@ def report(results, vertices):
                 100.0 * by_service.get('get_vertex_jacobians_compact', 0.0) / total,
                 100.0 * by_service.get('backprop', 0.0) / total, 100.0 * (1.0 - calls_time / total),
                 '%.1fx' % (s[0] / b[0]) if label == 'batched' else '1x', 'yes' if identical else 'NO'))
+    for frames, rows in results:
+        if frames == 1000:
+            speedup = rows['per-frame'][0] / rows['batched'][0]
+            lines += ['', 'Target: T = 1000 batched >= %gx faster than per-frame: %.1fx, %s.' % (
+                TARGET_SPEEDUP, speedup, 'met' if speedup >= TARGET_SPEEDUP else 'missed')]
     return '\n'.join(lines) + '\n'
 
 
