@@ -101,7 +101,8 @@ def trajectory_example(client, bodies, count):
 def trajectory_fitting_example(client, body, noise, frames):
     """Fits a toss; prints one row per solver; returns the list of failures."""
     times = np.arange(frames) / 100.0  # 100 frames per second
-    vertices = np.linspace(0, client.bodies().vertex_counts[0] - 1, 64).astype(np.uint32)
+    bodies = client.bodies()
+    vertices = np.linspace(0, bodies.vertex_counts[bodies.names.index(body)] - 1, 64).astype(np.uint32)
     per_frame = not trajectory_fitting.batched_calls_supported(client, body)
     observed, x_start = trajectory_fitting.make_problem(client, body, X_HIDDEN, times, vertices, noise, seed=5,
                                                         per_frame=per_frame)
