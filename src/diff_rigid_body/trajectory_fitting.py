@@ -135,18 +135,16 @@ def fit_torch(client, body, observed, times, x_start, vertices=None, per_frame=F
         gradients.append(float(x.grad.abs().max()))
         return loss
 
-    loss = float(optimizer.step(closure))
+    optimizer.step(closure)
     iterations = optimizer.state[optimizer._params[0]]['n_iter']
-    with torch.no_grad():  # the cost at the final x (the closure's last call may be a trial point)
-        p = drb_torch.vertex_positions(client, body, trajectory(x, times_t), vertices, per_frame)
-        loss = 0.5 * float(((p - observed_t) ** 2).sum())
-    calls = counter.count - 1
+    calls = counter.count
+    loss = float(closure())  # cost and gradient at the final x (the last evaluation may be a trial point)
     client.call = counter._call
     stopped = iterations < max_iterations
-    stationary = min(gradients) <= STATIONARY * gradients[0]
+    stationary = gradients[-1] <= STATIONARY * gradients[0]
     reason = 'iteration limit' if not stopped else 'tolerance' + ('' if stationary else ', not stationary')
     frames = len(times)
-    return TrajectoryFit(x.detach().numpy().copy(), iterations, evaluations[0], calls,
+    return TrajectoryFit(x.detach().numpy().copy(), iterations, evaluations[0] - 1, calls,
                          calls if per_frame else calls * frames, float(np.sqrt(2.0 * loss / observed.size)),
                          time.perf_counter() - start, bool(stopped and stationary), reason)
 
