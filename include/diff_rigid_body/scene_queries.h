@@ -21,8 +21,9 @@ namespace diff_rigid_body
 /// is allocated for it.
 struct RequestLimits
 {
-  /// Vertices in one get_vertex_jacobians or backprop request (positions and
-  /// Jacobians of 2^22 vertices take 640 MiB).
+  /// Vertices in one get_vertex_jacobians or backprop request, over all its
+  /// configurations (K x N for K configurations of N vertices; positions and
+  /// Jacobians of 2^22 vertices take 640 MiB). Also the most configurations.
   static constexpr std::size_t kMaxVertices = std::size_t(1) << 22;
   /// Mass matrices (configurations x bodies) in one get_mass_matrix request;
   /// with derivatives each costs 252 doubles (2 KiB).
@@ -83,8 +84,12 @@ public:
                                 const std::vector<double>& q, bool derivatives) const;
 
   /// Positions (3 per vertex, fixed frame) and Jacobians (18 per vertex, 3x6
-  /// row-major) of the selected vertices (empty = all), at `q` (6 values) or
-  /// at the current state when `q` is empty. Outputs are resized here.
+  /// row-major) of the N selected vertices (empty = all), at the current
+  /// state when `q` is empty, else at each of the K configurations in `q`
+  /// (6 K values): K x N x 3 positions and K x N x 18 values of J,
+  /// configuration-major, each configuration computed as a call with its 6
+  /// values alone would (same bits). K x N is at most
+  /// RequestLimits::kMaxVertices. Outputs are resized here.
   void vertexJacobians(const SceneState& current, const std::string& body, const std::vector<std::uint32_t>& vertices,
                        const std::vector<double>& q, std::vector<double>& positions,
                        std::vector<double>& jacobians) const;
@@ -95,22 +100,43 @@ public:
   /// translation block is always I3), stored as Out: double, or float for
   /// the float32 transport. The checks and messages of vertexJacobians; a
   /// request whose outputs would overflow Out is refused before anything is
-  /// written. Outputs are resized here (rotation_jacobians to 0 when
-  /// `positions_only`). Instantiated for Out = double and float.
+  /// written. K configurations in `q` as vertexJacobians (K x N x 3
+  /// positions, K x N x 9 rotation_jacobians, configuration-major). Outputs
+  /// are resized here (rotation_jacobians to 0 when `positions_only`).
+  /// Instantiated for Out = double and float.
   template <typename Out>
   void vertexRotationJacobians(const SceneState& current, const std::string& body,
                                const std::vector<std::uint32_t>& vertices, const std::vector<double>& q,
                                bool positions_only, std::vector<Out>& positions,
                                std::vector<Out>& rotation_jacobians) const;
 
-  /// dL/dq = sum_i J_i^T g_i for gradients g (3 per selected vertex).
+  /// dL/dq = sum_i J_i^T g_i at each of the K configurations of `q` (6 K
+  /// values; empty = the current state, K = 1), for gradients g given as
+  /// K x N x 3 values (configuration-major: 3 per selected vertex for each
+  /// configuration). Returns K x 6 values, configuration k's as a call with
+  /// its q and gradients alone would give them (same bits).
+  std::vector<double> backpropConfigurations(const SceneState& current, const std::string& body,
+                                             const std::vector<std::uint32_t>& vertices,
+                                             const std::vector<double>& gradients,
+                                             const std::vector<double>& q) const;
+
+  /// backpropConfigurations for one configuration (`q` empty or 6 values).
   Vector6<double> backprop(const SceneState& current, const std::string& body,
                            const std::vector<std::uint32_t>& vertices, const std::vector<double>& gradients,
                            const std::vector<double>& q) const;
 
 private:
-  /// The 6 values of q for body `index`: `q` if given, else the current state.
-  Vector6<double> stateOrCurrent(const SceneState& current, std::size_t index, const std::vector<double>& q) const;
+  /// K for a request's `q` (empty = 1, else its size / 6), checked against
+  /// its size (a multiple of 6) and the vertex limit for K x `vertex_count`.
+  std::size_t configurationCount(const std::vector<double>& q, std::size_t vertex_count) const;
+  /// The 6 values of configuration k of body `index`: q + 6 k, or the current state when `q` is empty.
+  const double* configurationQ(const SceneState& current, std::size_t index, const std::vector<double>& q,
+                               std::size_t k) const;
+  /// Refuses, naming the configuration when there are several, a
+  /// configuration whose bound |t|_inf + inflation max_i |p0_i| on every
+  /// output exceeds `limit` ("... would overflow<suffix>").
+  void checkPositionsFit(const SceneState& current, std::size_t index, const std::vector<double>& q,
+                         std::size_t configurations, double inflation, double limit, const char* suffix) const;
   /// Checks every index of `vertices` against body `index`.
   std::size_t checkVertices(std::size_t index, const std::vector<std::uint32_t>& vertices) const;
 

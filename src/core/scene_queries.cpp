@@ -214,17 +214,6 @@ MassMatrixAnswer SceneQueries::massMatrices(const SceneState& current, const std
   return answer;
 }
 
-Vector6<double> SceneQueries::stateOrCurrent(const SceneState& current, std::size_t index,
-                                             const std::vector<double>& q) const
-{
-  if (q.empty())
-    return current[index];
-  if (q.size() != 6)
-    reject(sizeMismatch("q", "6 values (or empty for the current state)", q.size()));
-  requireFinite(q.data(), 6, "q");
-  return Eigen::Map<const Vector6<double>>(q.data());
-}
-
 std::size_t SceneQueries::checkVertices(std::size_t index, const std::vector<std::uint32_t>& vertices) const
 {
   const RigidBody& body = scene_.bodies[index].body;
@@ -245,20 +234,68 @@ std::size_t SceneQueries::checkVertices(std::size_t index, const std::vector<std
   return count;
 }
 
+std::size_t SceneQueries::configurationCount(const std::vector<double>& q, std::size_t vertex_count) const
+{
+  if (q.empty())
+    return 1;
+  if (q.size() % 6 != 0)
+    reject(sizeMismatch("q", "6 values per configuration (6 K for K configurations, or empty for the current state)",
+                        q.size()));
+  const std::size_t configurations = q.size() / 6;
+  const std::size_t limit = RequestLimits::kMaxVertices;
+  // Both factors are at most 2^22 when multiplied, so the product cannot wrap.
+  if (configurations > limit || configurations * vertex_count > limit)
+  {
+    std::ostringstream why;
+    why << "q, vertices: expected at most " << limit << " vertices over all configurations (configurations x "
+        << "vertices), got " << configurations << " x " << vertex_count;
+    reject(why.str());
+  }
+  return configurations;
+}
+
+void SceneQueries::checkPositionsFit(const SceneState& current, std::size_t index, const std::vector<double>& q,
+                                     std::size_t configurations, double inflation, double limit,
+                                     const char* suffix) const
+{
+  // B = |t|_inf + inflation r, r = max_i |p0_i|, bounds every output of a
+  // configuration (see vertexRotationJacobians for the inflation).
+  for (std::size_t k = 0; k < configurations; ++k)
+  {
+    const double* qk = configurationQ(current, index, q, k);
+    const double t = std::max({ std::abs(qk[TX]), std::abs(qk[TY]), std::abs(qk[TZ]) });
+    if (!(t + inflation * vertex_radius_[index] <= limit))
+      reject((configurations > 1 ? "q (configuration " + std::to_string(k) + ")" : std::string("q")) +
+             ": position too large: vertex positions of body '" + scene_.bodies[index].body.name +
+             "' would overflow" + suffix);
+  }
+}
+
+const double* SceneQueries::configurationQ(const SceneState& current, std::size_t index, const std::vector<double>& q,
+                                           std::size_t k) const
+{
+  return q.empty() ? current[index].data() : q.data() + 6 * k;
+}
+
 void SceneQueries::vertexJacobians(const SceneState& current, const std::string& body_name,
                                    const std::vector<std::uint32_t>& vertices, const std::vector<double>& q,
                                    std::vector<double>& positions, std::vector<double>& jacobians) const
 {
   const std::size_t index = bodyIndex(body_name, "body");
   const std::size_t count = checkVertices(index, vertices);
-  const BodyPose<double> pose(stateOrCurrent(current, index, q));
-  // |p| <= |t|_inf + max_i |p0_i| bounds every output, so one check up front
-  // rules out overflow for all vertices.
-  if (!std::isfinite(pose.t.cwiseAbs().maxCoeff() + vertex_radius_[index]))
-    reject("q: position too large: vertex positions of body '" + body_name + "' would overflow");
-  positions.resize(3 * count);
-  jacobians.resize(18 * count);
-  vertexPositionsAndJacobians(pose, scene_.bodies[index].body.vertices, vertices, positions.data(), jacobians.data());
+  const std::size_t configurations = configurationCount(q, count);
+  requireFinite(q.data(), q.size(), "q");
+  // |p| <= |t|_inf + max_i |p0_i| bounds every output, so one check per
+  // configuration up front rules out overflow for all vertices.
+  checkPositionsFit(current, index, q, configurations, 1.0, std::numeric_limits<double>::max(), "");
+  positions.resize(3 * count * configurations);
+  jacobians.resize(18 * count * configurations);
+  for (std::size_t k = 0; k < configurations; ++k)
+  {
+    const BodyPose<double> pose(Eigen::Map<const Vector6<double>>(configurationQ(current, index, q, k)));
+    vertexPositionsAndJacobians(pose, scene_.bodies[index].body.vertices, vertices, positions.data() + 3 * count * k,
+                                jacobians.data() + 18 * count * k);
+  }
 }
 
 template <typename Out>
@@ -269,25 +306,29 @@ void SceneQueries::vertexRotationJacobians(const SceneState& current, const std:
 {
   const std::size_t index = bodyIndex(body_name, "body");
   const std::size_t count = checkVertices(index, vertices);
-  const BodyPose<double> pose(stateOrCurrent(current, index, q));
+  const std::size_t configurations = configurationCount(q, count);
   // B = |t|_inf + r, r = max_i |p0_i|, bounds every output: |p_k| <= |t_k| + |R p0|,
   // and column j of Jr is T e_j x R p0 with |T e_j| = 1, so |Jr_kj| <= |p0|.
   // Rounding (in R p0, the cross products and the norm behind r) adds less than
   // 20 eps r, so with r inflated by 64 eps, B rounded to nearest <= max(Out)
-  // rules out inf in every output, with one check for all vertices. Up to
+  // rules out inf in every output, with one check per configuration. Up to
   // that term (below an ulp of B unless r > 1e306 m) this is the test of
   // vertexJacobians: B finite in double.
   constexpr double kInflation = 1.0 + 64 * std::numeric_limits<double>::epsilon();
   constexpr double kLimit = std::numeric_limits<Out>::max();
-  if (!(pose.t.cwiseAbs().maxCoeff() + kInflation * vertex_radius_[index] <= kLimit))
-    reject("q: position too large: vertex positions of body '" + body_name + "' would overflow" +
-           (std::is_same<Out, float>::value ? " float32" : ""));
-  positions.resize(3 * count);
-  rotation_jacobians.resize(positions_only ? 0 : 9 * count);
-  vertexPositionsAndRotationJacobians(pose, scene_.bodies[index].body.vertices, vertices, positions.data(),
-                                      positions_only ? nullptr : rotation_jacobians.data());
+  requireFinite(q.data(), q.size(), "q");
+  checkPositionsFit(current, index, q, configurations, kInflation, kLimit,
+                    std::is_same<Out, float>::value ? " float32" : "");
+  positions.resize(3 * count * configurations);
+  rotation_jacobians.resize(positions_only ? 0 : 9 * count * configurations);
+  for (std::size_t k = 0; k < configurations; ++k)
+  {
+    const BodyPose<double> pose(Eigen::Map<const Vector6<double>>(configurationQ(current, index, q, k)));
+    vertexPositionsAndRotationJacobians(pose, scene_.bodies[index].body.vertices, vertices,
+                                        positions.data() + 3 * count * k,
+                                        positions_only ? nullptr : rotation_jacobians.data() + 9 * count * k);
+  }
 }
-
 template void SceneQueries::vertexRotationJacobians<double>(const SceneState&, const std::string&,
                                                             const std::vector<std::uint32_t>&,
                                                             const std::vector<double>&, bool, std::vector<double>&,
@@ -297,27 +338,53 @@ template void SceneQueries::vertexRotationJacobians<float>(const SceneState&, co
                                                            const std::vector<double>&, bool, std::vector<float>&,
                                                            std::vector<float>&) const;
 
+std::vector<double> SceneQueries::backpropConfigurations(const SceneState& current, const std::string& body_name,
+                                                         const std::vector<std::uint32_t>& vertices,
+                                                         const std::vector<double>& gradients,
+                                                         const std::vector<double>& q) const
+{
+  const std::size_t index = bodyIndex(body_name, "body");
+  const std::size_t count = checkVertices(index, vertices);
+  const std::size_t configurations = configurationCount(q, count);
+  if (gradients.size() != 3 * count * configurations)
+  {
+    if (configurations == 1)
+      reject(sizeMismatch("gradients", "3 per vertex = " + std::to_string(3 * count), gradients.size()));
+    reject(sizeMismatch("gradients",
+                        "3 per vertex and configuration = 3 x " + std::to_string(count) + " vertices x " +
+                            std::to_string(configurations) + " configurations = " +
+                            std::to_string(3 * count * configurations),
+                        gradients.size()));
+  }
+  requireFinite(q.data(), q.size(), "q");
+  std::vector<double> gradient(6 * configurations);
+  for (std::size_t k = 0; k < configurations; ++k)
+  {
+    const BodyPose<double> pose(Eigen::Map<const Vector6<double>>(configurationQ(current, index, q, k)));
+    // All vertices or an index list: the by-coordinate engine (vertex_columns.h).
+    const Vector6<double> dL_dq =
+        backpropagateVertexGradients(pose, vertex_columns_[index], vertices, gradients.data() + 3 * count * k);
+    std::copy(dL_dq.data(), dL_dq.data() + 6, gradient.data() + 6 * k);
+  }
+  // One pass over the gradients, not two: dL/dt = sum_i g_i is not finite
+  // whenever some g_i is not (inf and NaN never cancel back to a finite
+  // value), so only a non-finite answer needs the scan that names the index.
+  if (!std::all_of(gradient.begin(), gradient.end(), [](double value) { return std::isfinite(value); }))
+  {
+    requireFinite(gradients.data(), gradients.size(), "gradients");
+    requireFinite(gradient.data(), gradient.size(), "result gradient (the gradients are too large)");
+  }
+  return gradient;
+}
+
 Vector6<double> SceneQueries::backprop(const SceneState& current, const std::string& body_name,
                                        const std::vector<std::uint32_t>& vertices,
                                        const std::vector<double>& gradients, const std::vector<double>& q) const
 {
-  const std::size_t index = bodyIndex(body_name, "body");
-  const std::size_t count = checkVertices(index, vertices);
-  if (gradients.size() != 3 * count)
-    reject(sizeMismatch("gradients", "3 per vertex = " + std::to_string(3 * count), gradients.size()));
-  const BodyPose<double> pose(stateOrCurrent(current, index, q));
-  // All vertices or an index list: the by-coordinate engine (vertex_columns.h).
-  const Vector6<double> gradient =
-      backpropagateVertexGradients(pose, vertex_columns_[index], vertices, gradients.data());
-  // One pass over the gradients, not two: dL/dt = sum_i g_i is not finite
-  // whenever some g_i is not (inf and NaN never cancel back to a finite
-  // value), so only a non-finite answer needs the scan that names the index.
-  if (!gradient.allFinite())
-  {
-    requireFinite(gradients.data(), gradients.size(), "gradients");
-    requireFinite(gradient.data(), 6, "result gradient (the gradients are too large)");
-  }
-  return gradient;
+  if (!q.empty() && q.size() != 6)  // one configuration only: backpropConfigurations takes several
+    reject(sizeMismatch("q", "6 values (or empty for the current state)", q.size()));
+  const std::vector<double> gradient = backpropConfigurations(current, body_name, vertices, gradients, q);
+  return Eigen::Map<const Vector6<double>>(gradient.data());
 }
 
 }  // namespace diff_rigid_body

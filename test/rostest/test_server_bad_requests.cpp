@@ -181,8 +181,8 @@ TEST_F(BadRequests, NonFiniteValues)
 TEST_F(BadRequests, WrongArraySizes)
 {
   RigidBodyClient& node = server();
-  // q: 6 values or empty (raw: the client sends 6 or none).
-  for (std::size_t size : { 1u, 5u, 7u, 12u })
+  // q: empty or 6 values per configuration (raw: the client sends whole configurations or none).
+  for (std::size_t size : { 1u, 5u, 7u, 13u })
   {
     SCOPED_TRACE("q of " + std::to_string(size) + " values");
     expectRefusedRaw(rawVertexJacobians("tet", std::vector<double>(size, 0.1)), { "q", std::to_string(size) },

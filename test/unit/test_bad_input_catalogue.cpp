@@ -554,8 +554,9 @@ std::vector<Row> requestRows()
   };
   auto grad = [current](const std::string& body, const std::vector<std::uint32_t>& vertices,
                         const std::vector<double>& gradients, const std::vector<double>& q) {
-    twoBodies().backprop(current, body, vertices, gradients, q);
-    return std::string("accepted");
+    // The node's entry point (K configurations; K = 1 here unless q holds more).
+    const std::vector<double> gradient = twoBodies().backpropConfigurations(current, body, vertices, gradients, q);
+    return std::to_string(gradient.size() / 6) + " gradients";
   };
   auto set = [current](const std::vector<drb::NamedState>& updates) {
     twoBodies().applyStates(current, updates);
@@ -709,6 +710,22 @@ std::vector<Row> requestRows()
         EXPECT_EQ(compactOfBox<float>("0.2 0.2 0.2", { 0, 0, 0, 3.4e38, 0, 0 }), "8 vertices");
         return std::string("accepted: finite float32 positions (3.4e38 + 0.1 rounds to 3.4e38)");
       } },
+    { "R38", "get_vertex_jacobians: q of 13 values (two configurations and one value)", Expect::Refused,
+      "InvalidArgumentError", "q: expected 6 values per configuration",
+      [=] { return jac("cube", {}, std::vector<double>(13, 0.0)); } },
+    { "R39", "get_vertex_jacobians: 3 configurations of 2 vertices", Expect::Accepted, "", "",
+      [=] {
+        EXPECT_EQ(jac("cube", { 0, 7 }, std::vector<double>(18, 0.5)), "6 vertices");
+        return std::string("accepted: 3 blocks of 2 vertices, configuration-major");
+      } },
+    { "R40", "get_vertex_jacobians: configurations x vertices over 2^22 (36793 configurations of the 114 of ball)",
+      Expect::Refused, "InvalidArgumentError", "q, vertices: expected at most 4194304 vertices over all configurations",
+      [=] { return jac("ball", {}, std::vector<double>(6 * (drb::RequestLimits::kMaxVertices / 114 + 1), 0.0)); } },
+    { "R41", "backprop: gradients for one configuration, q for two", Expect::Refused, "InvalidArgumentError",
+      "gradients: expected 3 per vertex and configuration", [=] { return grad("cube", { 1, 2 }, std::vector<double>(6, 1.0), std::vector<double>(12, 0.0)); } },
+    { "R42", "get_vertex_jacobians_compact, single_precision: configuration 1 of 2 at a translation of 3.5e38",
+      Expect::Refused, "InvalidArgumentError", "q (configuration 1): position too large",
+      [] { return compactOfBox<float>("0.2 0.2 0.2", { 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, -3.5e38 }); } },
   };
 }
 
