@@ -270,6 +270,28 @@ public:
     return vertexJacobians(body, &q, vertices);
   }
 
+  /// K configurations in one call: positions and J of `body`'s `vertices`
+  /// (empty = all) at each q of `qs`, block k for qs[k] (the same bits as a
+  /// call with qs[k] alone). The node's state is not changed.
+  std::vector<VertexJacobians> vertexJacobians(const std::string& body, const std::vector<Vector6d>& qs,
+                                               const std::vector<std::uint32_t>& vertices = {})
+  {
+    diff_rigid_body::GetVertexJacobians srv;
+    srv.request.body = body;
+    srv.request.vertices = vertices;
+    srv.request.q = flatten(qs);
+    call(get_vertex_jacobians_, "get_vertex_jacobians", srv);
+    const auto& r = srv.response;
+    const Eigen::Index n = vertexCount(r.positions.size(), qs.size());
+    std::vector<VertexJacobians> out(qs.size());
+    for (std::size_t k = 0; k < qs.size(); ++k)
+    {
+      out[k].positions = Eigen::Map<const Eigen::Matrix3Xd>(r.positions.data() + 3 * n * k, 3, n);
+      out[k].J = Eigen::Map<const StackedJacobians>(r.jacobians.data() + 18 * n * k, 3 * n, 6);
+    }
+    return out;
+  }
+
   /// dL/dq from dL/dp (3 x N, column v for vertex v) of `body`'s `vertices`
   /// (empty = all) at `q` (nullptr = the current state). J is never formed.
   Vector6d backprop(const std::string& body, const Eigen::Matrix3Xd& gradients, const Vector6d* q = nullptr,
@@ -288,6 +310,28 @@ public:
                     const std::vector<std::uint32_t>& vertices = {})
   {
     return backprop(body, gradients, &q, vertices);
+  }
+
+  /// K configurations in one call: dL/dq at each q of `qs` from dL_dp[k]
+  /// (3 x N, column v for vertex v) at qs[k]; entry k has the same bits as a
+  /// call with dL_dp[k] and qs[k] alone. dL_dp and qs have the same size.
+  std::vector<Vector6d> backprop(const std::string& body, const std::vector<Eigen::Matrix3Xd>& dL_dp,
+                                 const std::vector<Vector6d>& qs, const std::vector<std::uint32_t>& vertices = {})
+  {
+    if (dL_dp.size() != qs.size())
+      throw std::invalid_argument("backprop: " + std::to_string(dL_dp.size()) + " gradient blocks for " +
+                                  std::to_string(qs.size()) + " configurations");
+    diff_rigid_body::Backprop srv;
+    srv.request.body = body;
+    srv.request.vertices = vertices;
+    for (const Eigen::Matrix3Xd& gradients : dL_dp)
+      srv.request.gradients.insert(srv.request.gradients.end(), gradients.data(), gradients.data() + gradients.size());
+    srv.request.q = flatten(qs);
+    call(backprop_, "backprop", srv);
+    std::vector<Vector6d> out(qs.size());
+    for (std::size_t k = 0; k < qs.size(); ++k)
+      out[k] = Eigen::Map<const Vector6d>(srv.response.gradient.data() + 6 * k);
+    return out;
   }
 
   /// The reduced transport of vertexJacobians: positions and the rotation
@@ -327,6 +371,35 @@ public:
     return vertexJacobiansCompact<Scalar>(body, &q, vertices, positions_only);
   }
 
+  /// K configurations in one call: block k for qs[k], as vertexJacobians.
+  template <typename Scalar = double>
+  std::vector<VertexRotationJacobians<Scalar>> vertexJacobiansCompact(const std::string& body,
+                                                                      const std::vector<Vector6d>& qs,
+                                                                      const std::vector<std::uint32_t>& vertices = {},
+                                                                      bool positions_only = false)
+  {
+    diff_rigid_body::GetVertexJacobiansCompact srv;
+    srv.request.body = body;
+    srv.request.vertices = vertices;
+    srv.request.q = flatten(qs);
+    srv.request.positions_only = positions_only;
+    srv.request.single_precision = std::is_same<Scalar, float>::value;
+    call(get_vertex_jacobians_compact_, "get_vertex_jacobians_compact", srv);
+    const auto& r = srv.response;
+    const std::vector<Scalar>& positions = compactField<Scalar>(r.positions, r.positions_f32);
+    const std::vector<Scalar>& jacobians = compactField<Scalar>(r.rotation_jacobians, r.rotation_jacobians_f32);
+    const Eigen::Index n = vertexCount(positions.size(), qs.size());
+    const Eigen::Index rows = positions_only ? 0 : 3 * n;
+    std::vector<VertexRotationJacobians<Scalar>> out(qs.size());
+    for (std::size_t k = 0; k < qs.size(); ++k)
+    {
+      out[k].positions = Eigen::Map<const Eigen::Matrix<Scalar, 3, Eigen::Dynamic>>(positions.data() + 3 * n * k, 3, n);
+      out[k].Jr = Eigen::Map<const typename VertexRotationJacobians<Scalar>::StackedRotationJacobians>(
+          jacobians.data() + 3 * rows * k, rows, 3);
+    }
+    return out;
+  }
+
   const std::string& server() const { return server_; }
 
 private:
@@ -354,6 +427,24 @@ private:
     }
     if (!srv.response.success)
       throw ServiceError(server_ + "/" + service, srv.response.message);
+  }
+
+  /// The 6 K values of a batched request's q (K >= 1: an empty q would mean the current state).
+  static std::vector<double> flatten(const std::vector<Vector6d>& qs)
+  {
+    if (qs.empty())
+      throw std::invalid_argument("qs: at least one configuration");
+    std::vector<double> q;
+    q.reserve(6 * qs.size());
+    for (const Vector6d& one : qs)
+      q.insert(q.end(), one.data(), one.data() + 6);
+    return q;
+  }
+
+  /// N from the size of a K x N x 3 positions field.
+  static Eigen::Index vertexCount(std::size_t position_values, std::size_t configurations)
+  {
+    return configurations ? static_cast<Eigen::Index>(position_values / (3 * configurations)) : 0;
   }
 
   /// The float64 or the float32 field of a compact response.

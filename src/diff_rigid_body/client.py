@@ -13,11 +13,13 @@ Shapes (n bodies, N vertices, K configurations; q = (phi, theta, psi, tx, ty, tz
 ``mass_matrix(...).M``          (n, 6, 6), or (K, n, 6, 6) for a batched ``q``
 ``mass_matrix(...).dM``         (n, 6, 6, 6): ``dM[i, j]`` = dM/dq_j of body i
                                 (a 6x6 matrix); (K, n, 6, 6, 6) when batched
-``vertex_jacobians(...)``       positions (N, 3) [m], J (N, 3, 6): ``J[v]`` = dp_v/dq
+``vertex_jacobians(...)``       positions (N, 3) [m], J (N, 3, 6): ``J[v]`` = dp_v/dq;
+                                (K, N, 3) and (K, N, 3, 6) for a q of shape (K, 6)
 ``vertex_jacobians_compact()``  positions (N, 3) [m], Jr (N, 3, 3): ``Jr[v]`` =
                                 dp_v/d(phi, theta, psi), J = [Jr | I3]; float32
-                                with ``single_precision``
-``backprop(...)``               dL/dq, (6,)
+                                with ``single_precision``; (K, N, 3), (K, N, 3, 3)
+                                for a q of shape (K, 6)
+``backprop(...)``               dL/dq, (6,); (K, 6) for a q of shape (K, 6)
 ``get_state()``                 dict name -> q (6,)
 ==============================  ===============================================
 
@@ -117,6 +119,25 @@ def _indices(vertices):
 def _pose(q):
     """A request's optional q: empty = the node's current state, else 6 values."""
     return [] if q is None else _floats(q)
+
+
+def _configurations(q):
+    """K for a vertex request's q of shape (K, 6), or None for one configuration (None or (6,))."""
+    if q is None or np.ndim(q) < 2:
+        return None
+    if np.shape(q)[0] == 0:  # an empty q would mean the current state
+        raise ValueError('q: at least one configuration, got shape %s' % (np.shape(q),))
+    return int(np.shape(q)[0])
+
+
+def _blocks(values, configurations, shape):
+    """``values`` as (N,) + shape, or (K, N) + shape when ``configurations`` = K is not None."""
+    values = np.asarray(values)
+    if configurations is None:
+        return values.reshape((-1,) + shape)
+    per_vertex = int(np.prod(shape))
+    vertices = values.size // (configurations * per_vertex) if configurations else 0
+    return values.reshape((configurations, vertices) + shape)
 
 
 class RigidBodyClient(object):
@@ -236,30 +257,44 @@ class RigidBodyClient(object):
 
     def vertex_jacobians(self, body, q=None, vertices=None):
         """positions (N, 3) [m, fixed frame] and J (N, 3, 6) = dp/dq of ``body``'s
-        ``vertices`` (None = all) at ``q`` (None = current state, else (6,))."""
+        ``vertices`` (None = all) at ``q`` (None = current state, else (6,)).
+
+        A ``q`` of shape (K, 6) evaluates K configurations in one call:
+        positions (K, N, 3) and J (K, N, 3, 6), each configuration's block the
+        same bits as a call with that q alone. The node's state is not changed."""
+        K = _configurations(q)
         r = self.call('get_vertex_jacobians', body=body, vertices=_indices(vertices), q=_pose(q))
-        return np.asarray(r.positions).reshape(-1, 3), np.asarray(r.jacobians).reshape(-1, 3, 6)
+        return _blocks(r.positions, K, (3,)), _blocks(r.jacobians, K, (3, 6))
 
     def vertex_jacobians_compact(self, body, q=None, vertices=None, positions_only=False, single_precision=False):
         """The reduced transport of :meth:`vertex_jacobians`: positions (N, 3) [m]
         and the rotation blocks Jr (N, 3, 3), ``Jr[v]`` = dp_v/d(phi, theta, psi)
         (J = [Jr | I3]); Jr is None with ``positions_only``. With
-        ``single_precision`` both are float32 (the float64 values rounded)."""
+        ``single_precision`` both are float32 (the float64 values rounded).
+        A ``q`` of shape (K, 6): (K, N, 3) and (K, N, 3, 3)."""
+        K = _configurations(q)
         r = self.call('get_vertex_jacobians_compact', body=body, vertices=_indices(vertices), q=_pose(q),
                       positions_only=bool(positions_only), single_precision=bool(single_precision))
         if single_precision:
             positions, jacobians = r.positions_f32, r.rotation_jacobians_f32
         else:
             positions, jacobians = r.positions, r.rotation_jacobians
-        positions = np.asarray(positions).reshape(-1, 3)
-        return positions, None if positions_only else np.asarray(jacobians).reshape(-1, 3, 3)
+        return _blocks(positions, K, (3,)), None if positions_only else _blocks(jacobians, K, (3, 3))
 
     def positions(self, body, q=None, vertices=None):
-        """positions (N, 3) [m] only (the same service; J is discarded)."""
+        """positions (N, 3) [m] only, or (K, N, 3) for a q of shape (K, 6) (the
+        same service; J is discarded)."""
         return self.vertex_jacobians(body, q, vertices)[0]
 
     def backprop(self, body, gradients, q=None, vertices=None):
         """dL/dq (6,) from ``gradients`` = dL/dp, (N, 3), of ``body``'s ``vertices``
-        (None = all) at ``q`` (None = current state). J is never formed."""
+        (None = all) at ``q`` (None = current state). J is never formed.
+
+        With ``q`` of shape (K, 6) and ``gradients`` of shape (K, N, 3) (the
+        dL/dp of configuration k in ``gradients[k]``): dL/dq of each
+        configuration, (K, 6), each row the same bits as a call with that q
+        and gradients alone."""
+        K = _configurations(q)
         r = self.call('backprop', body=body, vertices=_indices(vertices), gradients=_floats(gradients), q=_pose(q))
-        return np.asarray(r.gradient)
+        gradient = np.asarray(r.gradient)
+        return gradient.reshape(6) if K is None else gradient.reshape(K, 6)

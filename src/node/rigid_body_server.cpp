@@ -323,9 +323,8 @@ bool RigidBodyServer::getVertexJacobians(GetVertexJacobians::Request& request,
 bool RigidBodyServer::backprop(Backprop::Request& request, Backprop::Response& response)
 {
   return serve(response, "backprop", [&] {
-    const Vector6<double> gradient =
-        queries_.backprop(*snapshot(), request.body, request.vertices, request.gradients, request.q);
-    std::copy(gradient.data(), gradient.data() + 6, response.gradient.begin());
+    response.gradient =
+        queries_.backpropConfigurations(*snapshot(), request.body, request.vertices, request.gradients, request.q);
   });
 }
 
