@@ -103,13 +103,10 @@ def trajectory_fitting_example(client, body, noise, frames):
     times = np.arange(frames) / 100.0  # 100 frames per second
     bodies = client.bodies()
     vertices = np.linspace(0, bodies.vertex_counts[bodies.names.index(body)] - 1, 64).astype(np.uint32)
-    per_frame = not trajectory_fitting.batched_calls_supported(client, body)
-    observed, x_start = trajectory_fitting.make_problem(client, body, X_HIDDEN, times, vertices, noise, seed=5,
-                                                        per_frame=per_frame)
-    sigma = trajectory_fitting.standard_errors(client, body, X_HIDDEN, times, vertices, noise, per_frame)
+    observed, x_start = trajectory_fitting.make_problem(client, body, X_HIDDEN, times, vertices, noise, seed=5)
+    sigma = trajectory_fitting.standard_errors(client, body, X_HIDDEN, times, vertices, noise)
     print('\n3. Trajectory fitting of a tossed %r: q0, qdot0 from T = %d frames (%.2f s) of %d vertices, '
-          'noise %g m%s' % (body, frames, times[-1], len(vertices), noise,
-                            ' (PER-FRAME calls: the node takes no batch)' if per_frame else ''))
+          'noise %g m' % (body, frames, times[-1], len(vertices), noise))
     print('   start off by %.2e rad, %.2e m, %.2e rad/s, %.2e m/s; standard deviations of the estimate up to '
           '%.1e rad, %.1e m, %.1e rad/s, %.1e m/s' % (trajectory_fitting.errors(x_start, X_HIDDEN) + tuple(
               sigma.reshape(4, 3).max(axis=1))))
@@ -119,7 +116,7 @@ def trajectory_fitting_example(client, body, noise, frames):
     failures, fitted = [], []
     for label, fit in (('torch LBFGS (backprop)', trajectory_fitting.fit_torch),
                        ('least_squares (J)', trajectory_fitting.fit_least_squares)):
-        r = fit(client, body, observed, times, x_start, vertices, per_frame=per_frame)
+        r = fit(client, body, observed, times, x_start, vertices)
         e = trajectory_fitting.errors(r.x, X_HIDDEN)
         print('   %-22s %6d %6d %6d %10d %8.3e m %6.2e rad %6.2e m %6.2e r/s %6.2e m/s %7.3f s%s' % (
             (label, r.iterations, r.evaluations, r.calls, r.per_frame_calls, r.residual_rms) + e + (

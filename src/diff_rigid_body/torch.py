@@ -38,18 +38,14 @@ def positions_batch(client, body, q, vertices=None, per_frame=False):
     """positions (K, N, 3) of ``body``'s ``vertices`` at the K rows of ``q`` (K, 6)."""
     if per_frame:
         return np.stack([_positions(client, body, qk, vertices) for qk in q])
-    if len(q) == 1:
-        return _positions(client, body, q[0], vertices)[None]
-    return np.asarray(_positions(client, body, q, vertices)).reshape(len(q), -1, 3)
+    return _positions(client, body, q, vertices)
 
 
 def backprop_batch(client, body, gradients, q, vertices=None, per_frame=False):
     """dL/dq (K, 6) from dL/dp ``gradients`` (K, N, 3) at ``q`` (K, 6)."""
     if per_frame:
         return np.stack([client.backprop(body, g, qk, vertices) for g, qk in zip(gradients, q)])
-    if len(q) == 1:
-        return np.asarray(client.backprop(body, gradients[0], q[0], vertices))[None]
-    return np.asarray(client.backprop(body, gradients, q, vertices)).reshape(len(q), 6)
+    return client.backprop(body, gradients, q, vertices)
 
 
 class _VertexPositions(torch.autograd.Function):

@@ -28,7 +28,7 @@ import torch
 
 from diff_rigid_body import torch as drb_torch
 
-__all__ = ['GRAVITY', 'standard_errors', 'batched_calls_supported', 'trajectory', 'make_problem', 'fit_torch', 'fit_least_squares', 'errors', 'CallCounter',
+__all__ = ['GRAVITY', 'standard_errors', 'trajectory', 'make_problem', 'fit_torch', 'fit_least_squares', 'errors', 'CallCounter',
            'TrajectoryFit', 'jacobians_batch']
 
 GRAVITY = np.array([0.0, 0.0, 0.0, 0.0, 0.0, -9.81])  # d^2q/dt^2 [m/s^2] (angles: 0)
@@ -68,11 +68,7 @@ def jacobians_batch(client, body, q, vertices=None, per_frame=False):
     if per_frame:
         answers = [client.vertex_jacobians(body, qk, vertices) for qk in q]
         return np.stack([a[0] for a in answers]), np.stack([a[1] for a in answers])
-    if len(q) == 1:
-        p, J = client.vertex_jacobians(body, q[0], vertices)
-        return p[None], J[None]
-    p, J = client.vertex_jacobians(body, q, vertices)
-    return np.asarray(p).reshape(len(q), -1, 3), np.asarray(J).reshape(len(q), -1, 3, 6)
+    return client.vertex_jacobians(body, q, vertices)
 
 
 def make_problem(client, body, x_true, times, vertices, noise, seed=0, start_offsets=(0.1, 0.05, 0.3, 0.3),
@@ -98,14 +94,6 @@ def standard_errors(client, body, x, times, vertices, noise, per_frame=False):
     _, J = jacobians_batch(client, body, trajectory(np.asarray(x), times), vertices, per_frame)
     A = np.concatenate([J, J * np.asarray(times)[:, None, None, None]], axis=-1).reshape(-1, 12)
     return noise * np.sqrt(np.diag(np.linalg.inv(A.T.dot(A))))
-
-
-def batched_calls_supported(client, body):
-    """Whether the node answers a (K, 6) q in one call (else: per-frame calls)."""
-    try:
-        return np.shape(client.positions(body, np.zeros((2, 6)), [0])) in ((2, 1, 3), (2, 3))
-    except Exception:  # the node refuses 12 values of q
-        return False
 
 
 def errors(x, x_true):
