@@ -4,7 +4,7 @@
 //
 // The input is decoded with FuzzedDataProvider into up to 8 requests, each
 // one of set_state, get_state, get_mass_matrix, get_vertex_jacobians, its
-// compact variant (double and float32) and backprop, with fuzzed body names (known, unknown, empty, repeated, random
+// compact variant (double and float32) and backprop (K = 1 to 3 configurations), with fuzzed body names (known, unknown, empty, repeated, random
 // bytes), q and gradients (any double: NaN, +-Inf, subnormals, +-0, huge,
 // or plain values), vertex indices (in range or any uint32) and sizes.
 // set_state changes the current state that later requests see, so queries
@@ -12,7 +12,8 @@
 //
 // Invariants: a request either throws InvalidArgumentError and leaves its
 // outputs untouched, or answers with the documented sizes and only finite
-// numbers; set_state is all or nothing and stores q bit for bit.
+// numbers (K blocks for K configurations, each the bits of its single
+// request); set_state is all or nothing and stores q bit for bit.
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -218,12 +219,19 @@ std::vector<double> fuzzedQ(FuzzedDataProvider& in)
     return {};
   if (in.ConsumeBool())
   {
-    std::vector<double> q(6);
+    // K = 1 to 3 whole configurations.
+    std::vector<double> q(6 * in.ConsumeIntegralInRange<std::size_t>(1, 3));
     for (double& value : q)
       value = fuzzedDouble(in);
     return q;
   }
-  return fuzzedDoubles(in, 8);
+  return fuzzedDoubles(in, 20);
+}
+
+/// K of an accepted request's q: 1 when empty (the current state), else its size / 6.
+std::size_t configurationsOf(const std::vector<double>& q)
+{
+  return q.empty() ? 1 : q.size() / 6;
 }
 
 void getVertexJacobians(FuzzedDataProvider& in, const drb::SceneState& current)
@@ -246,9 +254,21 @@ void getVertexJacobians(FuzzedDataProvider& in, const drb::SceneState& current)
   require(index >= 0, "get_vertex_jacobians accepted an unknown body");
   const std::size_t count =
       vertices.empty() ? static_cast<std::size_t>(queries().body(index).vertices.cols()) : vertices.size();
-  require(positions.size() == 3 * count && jacobians.size() == 18 * count, "get_vertex_jacobians: wrong sizes");
+  const std::size_t K = configurationsOf(q);
+  require(positions.size() == 3 * count * K && jacobians.size() == 18 * count * K,
+          "get_vertex_jacobians: wrong sizes");
   requireAllFinite(positions.data(), positions.size(), "positions");
   requireAllFinite(jacobians.data(), jacobians.size(), "jacobians");
+  // Configuration k's block has the bits of a request with its 6 values alone.
+  for (std::size_t k = 0; K > 1 && k < K; ++k)
+  {
+    std::vector<double> p1, j1;
+    queries().vertexJacobians(current, body, vertices, std::vector<double>(q.begin() + 6 * k, q.begin() + 6 * k + 6),
+                              p1, j1);
+    require(std::memcmp(p1.data(), positions.data() + 3 * count * k, sizeof(double) * p1.size()) == 0 &&
+                std::memcmp(j1.data(), jacobians.data() + 18 * count * k, sizeof(double) * j1.size()) == 0,
+            "get_vertex_jacobians: a configuration's block differs from its single request");
+  }
 }
 
 /// ~get_vertex_jacobians_compact: positions and the rotation block, in
@@ -276,7 +296,8 @@ void vertexRotationJacobians(FuzzedDataProvider& in, const drb::SceneState& curr
   require(index >= 0, "get_vertex_jacobians_compact accepted an unknown body");
   const std::size_t count =
       vertices.empty() ? static_cast<std::size_t>(queries().body(index).vertices.cols()) : vertices.size();
-  require(positions.size() == 3 * count && rotation_jacobians.size() == (positions_only ? 0 : 9 * count),
+  const std::size_t K = configurationsOf(q);
+  require(positions.size() == 3 * count * K && rotation_jacobians.size() == (positions_only ? 0 : 9 * count * K),
           "get_vertex_jacobians_compact: wrong sizes");
   for (const std::vector<Out>* values : { &positions, &rotation_jacobians })
     for (std::size_t i = 0; i < values->size(); ++i)
@@ -295,7 +316,8 @@ void backprop(FuzzedDataProvider& in, const drb::SceneState& current)
     // The expected size, so that the values are what is tested.
     const std::size_t count =
         vertices.empty() ? static_cast<std::size_t>(queries().body(index).vertices.cols()) : vertices.size();
-    gradients.resize(3 * count + (in.ConsumeIntegralInRange<int>(0, 7) == 0 ? 1 : 0));
+    const std::size_t K = q.size() >= 6 ? q.size() / 6 : 1;
+    gradients.resize(3 * count * K + (in.ConsumeIntegralInRange<int>(0, 7) == 0 ? 1 : 0));
     for (double& value : gradients)
       value = fuzzedDouble(in);
   }
@@ -303,8 +325,9 @@ void backprop(FuzzedDataProvider& in, const drb::SceneState& current)
     gradients = fuzzedDoubles(in, 48);
   try
   {
-    const drb::Vector6<double> gradient = queries().backprop(current, body, vertices, gradients, q);
-    requireAllFinite(gradient.data(), 6, "backprop gradient");
+    const std::vector<double> gradient = queries().backpropConfigurations(current, body, vertices, gradients, q);
+    require(gradient.size() == 6 * configurationsOf(q), "backprop: wrong size");
+    requireAllFinite(gradient.data(), gradient.size(), "backprop gradient");
   }
   catch (const drb::InvalidArgumentError&)
   {
