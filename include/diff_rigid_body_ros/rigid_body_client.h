@@ -251,45 +251,20 @@ public:
   VertexJacobians vertexJacobians(const std::string& body, const Vector6d* q = nullptr,
                                   const std::vector<std::uint32_t>& vertices = {})
   {
-    diff_rigid_body::GetVertexJacobians srv;
-    srv.request.body = body;
-    srv.request.vertices = vertices;
-    if (q)
-      srv.request.q.assign(q->data(), q->data() + 6);
-    call(get_vertex_jacobians_, "get_vertex_jacobians", srv);
-    const auto& r = srv.response;
-    const Eigen::Index n = static_cast<Eigen::Index>(r.positions.size() / 3);
-    VertexJacobians out;
-    out.positions = Eigen::Map<const Eigen::Matrix3Xd>(r.positions.data(), 3, n);
-    out.J = Eigen::Map<const StackedJacobians>(r.jacobians.data(), 3 * n, 6);
-    return out;
+    return requestVertexJacobians(body, vertices, optionalQ(q), 1).front();
   }
   VertexJacobians vertexJacobians(const std::string& body, const Vector6d& q,
                                   const std::vector<std::uint32_t>& vertices = {})
   {
     return vertexJacobians(body, &q, vertices);
   }
-
   /// K configurations in one call: positions and J of `body`'s `vertices`
   /// (empty = all) at each q of `qs`, block k for qs[k] (the same bits as a
   /// call with qs[k] alone). The node's state is not changed.
   std::vector<VertexJacobians> vertexJacobians(const std::string& body, const std::vector<Vector6d>& qs,
                                                const std::vector<std::uint32_t>& vertices = {})
   {
-    diff_rigid_body::GetVertexJacobians srv;
-    srv.request.body = body;
-    srv.request.vertices = vertices;
-    srv.request.q = flatten(qs);
-    call(get_vertex_jacobians_, "get_vertex_jacobians", srv);
-    const auto& r = srv.response;
-    const Eigen::Index n = vertexCount(r.positions.size(), qs.size());
-    std::vector<VertexJacobians> out(qs.size());
-    for (std::size_t k = 0; k < qs.size(); ++k)
-    {
-      out[k].positions = Eigen::Map<const Eigen::Matrix3Xd>(r.positions.data() + 3 * n * k, 3, n);
-      out[k].J = Eigen::Map<const StackedJacobians>(r.jacobians.data() + 18 * n * k, 3 * n, 6);
-    }
-    return out;
+    return requestVertexJacobians(body, vertices, flatten(qs), qs.size());
   }
 
   /// dL/dq from dL/dp (3 x N, column v for vertex v) of `body`'s `vertices`
@@ -297,21 +272,13 @@ public:
   Vector6d backprop(const std::string& body, const Eigen::Matrix3Xd& gradients, const Vector6d* q = nullptr,
                     const std::vector<std::uint32_t>& vertices = {})
   {
-    diff_rigid_body::Backprop srv;
-    srv.request.body = body;
-    srv.request.vertices = vertices;
-    srv.request.gradients.assign(gradients.data(), gradients.data() + gradients.size());
-    if (q)
-      srv.request.q.assign(q->data(), q->data() + 6);
-    call(backprop_, "backprop", srv);
-    return Eigen::Map<const Vector6d>(srv.response.gradient.data());
+    return requestBackprop(body, vertices, { &gradients }, optionalQ(q), 1).front();
   }
   Vector6d backprop(const std::string& body, const Eigen::Matrix3Xd& gradients, const Vector6d& q,
                     const std::vector<std::uint32_t>& vertices = {})
   {
     return backprop(body, gradients, &q, vertices);
   }
-
   /// K configurations in one call: dL/dq at each q of `qs` from dL_dp[k]
   /// (3 x N, column v for vertex v) at qs[k]; entry k has the same bits as a
   /// call with dL_dp[k] and qs[k] alone. dL_dp and qs have the same size.
@@ -321,17 +288,10 @@ public:
     if (dL_dp.size() != qs.size())
       throw std::invalid_argument("backprop: " + std::to_string(dL_dp.size()) + " gradient blocks for " +
                                   std::to_string(qs.size()) + " configurations");
-    diff_rigid_body::Backprop srv;
-    srv.request.body = body;
-    srv.request.vertices = vertices;
+    std::vector<const Eigen::Matrix3Xd*> blocks;
     for (const Eigen::Matrix3Xd& gradients : dL_dp)
-      srv.request.gradients.insert(srv.request.gradients.end(), gradients.data(), gradients.data() + gradients.size());
-    srv.request.q = flatten(qs);
-    call(backprop_, "backprop", srv);
-    std::vector<Vector6d> out(qs.size());
-    for (std::size_t k = 0; k < qs.size(); ++k)
-      out[k] = Eigen::Map<const Vector6d>(srv.response.gradient.data() + 6 * k);
-    return out;
+      blocks.push_back(&gradients);
+    return requestBackprop(body, vertices, blocks, flatten(qs), qs.size());
   }
 
   /// The reduced transport of vertexJacobians: positions and the rotation
@@ -343,25 +303,7 @@ public:
                                                          const std::vector<std::uint32_t>& vertices = {},
                                                          bool positions_only = false)
   {
-    static_assert(std::is_same<Scalar, double>::value || std::is_same<Scalar, float>::value,
-                  "vertexJacobiansCompact: Scalar is double or float");
-    diff_rigid_body::GetVertexJacobiansCompact srv;
-    srv.request.body = body;
-    srv.request.vertices = vertices;
-    if (q)
-      srv.request.q.assign(q->data(), q->data() + 6);
-    srv.request.positions_only = positions_only;
-    srv.request.single_precision = std::is_same<Scalar, float>::value;
-    call(get_vertex_jacobians_compact_, "get_vertex_jacobians_compact", srv);
-    const auto& r = srv.response;
-    const std::vector<Scalar>& positions = compactField<Scalar>(r.positions, r.positions_f32);
-    const std::vector<Scalar>& jacobians = compactField<Scalar>(r.rotation_jacobians, r.rotation_jacobians_f32);
-    const Eigen::Index n = static_cast<Eigen::Index>(positions.size() / 3);
-    VertexRotationJacobians<Scalar> out;
-    out.positions = Eigen::Map<const Eigen::Matrix<Scalar, 3, Eigen::Dynamic>>(positions.data(), 3, n);
-    out.Jr = Eigen::Map<const typename VertexRotationJacobians<Scalar>::StackedRotationJacobians>(
-        jacobians.data(), static_cast<Eigen::Index>(jacobians.size() / 3), 3);
-    return out;
+    return requestCompact<Scalar>(body, vertices, optionalQ(q), 1, positions_only).front();
   }
   template <typename Scalar = double>
   VertexRotationJacobians<Scalar> vertexJacobiansCompact(const std::string& body, const Vector6d& q,
@@ -370,7 +312,6 @@ public:
   {
     return vertexJacobiansCompact<Scalar>(body, &q, vertices, positions_only);
   }
-
   /// K configurations in one call: block k for qs[k], as vertexJacobians.
   template <typename Scalar = double>
   std::vector<VertexRotationJacobians<Scalar>> vertexJacobiansCompact(const std::string& body,
@@ -378,26 +319,7 @@ public:
                                                                       const std::vector<std::uint32_t>& vertices = {},
                                                                       bool positions_only = false)
   {
-    diff_rigid_body::GetVertexJacobiansCompact srv;
-    srv.request.body = body;
-    srv.request.vertices = vertices;
-    srv.request.q = flatten(qs);
-    srv.request.positions_only = positions_only;
-    srv.request.single_precision = std::is_same<Scalar, float>::value;
-    call(get_vertex_jacobians_compact_, "get_vertex_jacobians_compact", srv);
-    const auto& r = srv.response;
-    const std::vector<Scalar>& positions = compactField<Scalar>(r.positions, r.positions_f32);
-    const std::vector<Scalar>& jacobians = compactField<Scalar>(r.rotation_jacobians, r.rotation_jacobians_f32);
-    const Eigen::Index n = vertexCount(positions.size(), qs.size());
-    const Eigen::Index rows = positions_only ? 0 : 3 * n;
-    std::vector<VertexRotationJacobians<Scalar>> out(qs.size());
-    for (std::size_t k = 0; k < qs.size(); ++k)
-    {
-      out[k].positions = Eigen::Map<const Eigen::Matrix<Scalar, 3, Eigen::Dynamic>>(positions.data() + 3 * n * k, 3, n);
-      out[k].Jr = Eigen::Map<const typename VertexRotationJacobians<Scalar>::StackedRotationJacobians>(
-          jacobians.data() + 3 * rows * k, rows, 3);
-    }
-    return out;
+    return requestCompact<Scalar>(body, vertices, flatten(qs), qs.size(), positions_only);
   }
 
   const std::string& server() const { return server_; }
@@ -427,6 +349,83 @@ private:
     }
     if (!srv.response.success)
       throw ServiceError(server_ + "/" + service, srv.response.message);
+  }
+
+  /// get_vertex_jacobians with `q` holding K configurations (or empty: the current state, K = 1).
+  std::vector<VertexJacobians> requestVertexJacobians(const std::string& body,
+                                                      const std::vector<std::uint32_t>& vertices,
+                                                      std::vector<double> q, std::size_t K)
+  {
+    diff_rigid_body::GetVertexJacobians srv;
+    srv.request.body = body;
+    srv.request.vertices = vertices;
+    srv.request.q = std::move(q);
+    call(get_vertex_jacobians_, "get_vertex_jacobians", srv);
+    const auto& r = srv.response;
+    const Eigen::Index n = vertexCount(r.positions.size(), K);
+    std::vector<VertexJacobians> out(K);
+    for (std::size_t k = 0; k < K; ++k)
+    {
+      out[k].positions = Eigen::Map<const Eigen::Matrix3Xd>(r.positions.data() + 3 * n * k, 3, n);
+      out[k].J = Eigen::Map<const StackedJacobians>(r.jacobians.data() + 18 * n * k, 3 * n, 6);
+    }
+    return out;
+  }
+
+  /// backprop with one 3 x N gradient block per configuration of `q`.
+  std::vector<Vector6d> requestBackprop(const std::string& body, const std::vector<std::uint32_t>& vertices,
+                                        const std::vector<const Eigen::Matrix3Xd*>& dL_dp, std::vector<double> q,
+                                        std::size_t K)
+  {
+    diff_rigid_body::Backprop srv;
+    srv.request.body = body;
+    srv.request.vertices = vertices;
+    for (const Eigen::Matrix3Xd* gradients : dL_dp)
+      srv.request.gradients.insert(srv.request.gradients.end(), gradients->data(),
+                                   gradients->data() + gradients->size());
+    srv.request.q = std::move(q);
+    call(backprop_, "backprop", srv);
+    std::vector<Vector6d> out(K);
+    for (std::size_t k = 0; k < K; ++k)
+      out[k] = Eigen::Map<const Vector6d>(srv.response.gradient.data() + 6 * k);
+    return out;
+  }
+
+  /// get_vertex_jacobians_compact in Scalar (float: single_precision), K configurations in `q`.
+  template <typename Scalar>
+  std::vector<VertexRotationJacobians<Scalar>> requestCompact(const std::string& body,
+                                                              const std::vector<std::uint32_t>& vertices,
+                                                              std::vector<double> q, std::size_t K,
+                                                              bool positions_only)
+  {
+    static_assert(std::is_same<Scalar, double>::value || std::is_same<Scalar, float>::value,
+                  "vertexJacobiansCompact: Scalar is double or float");
+    diff_rigid_body::GetVertexJacobiansCompact srv;
+    srv.request.body = body;
+    srv.request.vertices = vertices;
+    srv.request.q = std::move(q);
+    srv.request.positions_only = positions_only;
+    srv.request.single_precision = std::is_same<Scalar, float>::value;
+    call(get_vertex_jacobians_compact_, "get_vertex_jacobians_compact", srv);
+    const auto& r = srv.response;
+    const std::vector<Scalar>& positions = compactField<Scalar>(r.positions, r.positions_f32);
+    const std::vector<Scalar>& jacobians = compactField<Scalar>(r.rotation_jacobians, r.rotation_jacobians_f32);
+    const Eigen::Index n = vertexCount(positions.size(), K);
+    const Eigen::Index rows = positions_only ? 0 : 3 * n;
+    std::vector<VertexRotationJacobians<Scalar>> out(K);
+    for (std::size_t k = 0; k < K; ++k)
+    {
+      out[k].positions = Eigen::Map<const Eigen::Matrix<Scalar, 3, Eigen::Dynamic>>(positions.data() + 3 * n * k, 3, n);
+      out[k].Jr = Eigen::Map<const typename VertexRotationJacobians<Scalar>::StackedRotationJacobians>(
+          jacobians.data() + 3 * rows * k, rows, 3);
+    }
+    return out;
+  }
+
+  /// A single request's q: empty (the current state) or the 6 values of *q.
+  static std::vector<double> optionalQ(const Vector6d* q)
+  {
+    return q ? std::vector<double>(q->data(), q->data() + 6) : std::vector<double>();
   }
 
   /// The 6 K values of a batched request's q (K >= 1: an empty q would mean the current state).
