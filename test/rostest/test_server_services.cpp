@@ -1,4 +1,4 @@
-// The six services of a running rigid_body_server on the fixture scene
+// The services (get_bodies ... backprop) of a running rigid_body_server on the fixture scene
 // (test/urdf/fixture_scene.urdf), checked against
 //   (a) central finite differences of the positions and mass matrices the
 //       service itself returns at perturbed q (independent of its Jacobian
