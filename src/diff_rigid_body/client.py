@@ -122,12 +122,16 @@ def _pose(q):
 
 
 def _configurations(q):
-    """K for a vertex request's q of shape (K, 6), or None for one configuration (None or (6,))."""
-    if q is None or np.ndim(q) < 2:
+    """K for a vertex request's q of shape (K, 6) (or 6K flat values, K > 1), or None for one
+    configuration (None, empty or (6,)). A size the node refuses is left to the node's message."""
+    if q is None:
         return None
-    if np.shape(q)[0] == 0:  # an empty q would mean the current state
-        raise ValueError('q: at least one configuration, got shape %s' % (np.shape(q),))
-    return int(np.shape(q)[0])
+    if np.ndim(q) >= 2:
+        if np.shape(q)[0] == 0:  # an empty q would mean the current state
+            raise ValueError('q: at least one configuration, got shape %s' % (np.shape(q),))
+        return int(np.shape(q)[0])
+    size = int(np.size(q))
+    return None if size in (0, 6) or size % 6 else size // 6
 
 
 def _blocks(values, configurations, shape):

@@ -101,6 +101,14 @@ class PythonBatchedCalls(unittest.TestCase):
         with self.assertRaises(ValueError):
             c.vertex_jacobians('rock', q=np.zeros((0, 6)))
 
+    def test_flat_q_of_several_configurations_gives_batched_shapes(self):
+        qs = configurations(3)
+        P, J = self.client.vertex_jacobians('knot', q=qs.ravel().tolist(), vertices=[0, 1])
+        self.assertEqual((P.shape, J.shape), ((3, 2, 3), (3, 2, 3, 6)))
+        self.assertTrue(same_bits(P, self.client.positions('knot', q=qs, vertices=[0, 1])), 'flat q vs (K, 6) q')
+        dL_dq = self.client.backprop('knot', some_gradients(3, 2), q=qs.ravel(), vertices=[0, 1])
+        self.assertEqual(dL_dq.shape, (3, 6))
+
 
 if __name__ == '__main__':
     rostest.rosrun(PKG, 'batched_calls_python', PythonBatchedCalls)
