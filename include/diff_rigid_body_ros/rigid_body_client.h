@@ -10,10 +10,12 @@
 // This is the ROS layer: it lives outside include/diff_rigid_body/, the
 // ROS-free core.
 //
-// q = (phi, theta, psi [rad], tx, ty, tz [m]); matrices in q order.
+// x: a body's coordinates, d = dof values (client_types.h); a free body's x
+// is q = (phi, theta, psi [rad], tx, ty, tz [m]). A single configuration is
+// any Eigen vector (Vector6d for a free body, Eigen::VectorXd for any body);
+// matrices are in x order.
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -33,97 +35,10 @@
 #include <diff_rigid_body/GetVertexJacobiansCompact.h>
 #include <diff_rigid_body/SetState.h>
 
+#include "diff_rigid_body_ros/client_responses.h"
+
 namespace diff_rigid_body_ros
 {
-using Vector6d = Eigen::Matrix<double, 6, 1>;
-using Matrix6d = Eigen::Matrix<double, 6, 6>;
-/// Stacked vertex Jacobians: rows 3v..3v+2 are J_v = dp_v/dq (3x6).
-using StackedJacobians = Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>;
-
-/// A service answered success=false. message() is the node's explanation
-/// (it names the body, index or field); the node's state is unchanged.
-class ServiceError : public std::runtime_error
-{
-public:
-  ServiceError(const std::string& service, const std::string& message)
-    : std::runtime_error(service + ": " + message), service_(service), message_(message)
-  {
-  }
-  const std::string& service() const { return service_; }
-  const std::string& message() const { return message_; }
-
-private:
-  std::string service_;
-  std::string message_;
-};
-
-/// A service could not be reached (not advertised within the timeout, or the
-/// call failed again after reconnecting).
-class ConnectionError : public std::runtime_error
-{
-public:
-  using std::runtime_error::runtime_error;
-};
-
-/// One link of a body (get_bodies), in vertex order.
-struct Link
-{
-  std::string name;
-  double mass = 0.0;                                  ///< [kg], 0 for a massless frame
-  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();  ///< [kg m^2] about its COM, link axes
-  Eigen::Vector3d com_offset = Eigen::Vector3d::Zero();  ///< [m] its COM in its frame
-  std::uint32_t first_vertex = 0;  ///< its vertices: first_vertex .. first_vertex + vertex_count - 1
-  std::uint32_t vertex_count = 0;
-};
-
-/// get_bodies.
-struct Bodies
-{
-  std::string fixed_frame;
-  std::vector<std::string> names;
-  std::vector<double> masses;                     ///< [kg]
-  std::vector<Eigen::Matrix3d> inertias;          ///< [kg m^2] about the COM, body axes
-  std::vector<Eigen::Vector3d> com_offsets;       ///< [m] the COM in the link frame
-  std::vector<std::uint32_t> vertex_counts;
-  std::vector<std::uint32_t> dofs;                ///< len(x) per body
-  std::vector<std::vector<std::string>> joint_names;  ///< per body, in x order
-  std::vector<std::vector<Link>> links;           ///< per body, in vertex order
-};
-
-/// get_mass_matrix: K configurations of n bodies.
-struct MassMatrices
-{
-  std::vector<std::string> bodies;             ///< the n bodies, in answer order
-  std::size_t configurations = 0;              ///< K
-  std::vector<Matrix6d> M;                     ///< K*n matrices; configuration k, body i at k*n + i
-  std::vector<std::array<Matrix6d, 6>> dM;     ///< with derivatives: dM[k*n + i][j] = dM/dq_j
-  std::vector<double> cos_theta;               ///< gimbal-lock diagnostic, one per matrix
-
-  const Matrix6d& at(std::size_t k, std::size_t i) const { return M.at(k * bodies.size() + i); }
-};
-
-/// get_vertex_jacobians.
-struct VertexJacobians
-{
-  Eigen::Matrix3Xd positions;  ///< [m] column v = vertex v in the fixed frame
-  StackedJacobians J;          ///< 3N x 6; J.middleRows<3>(3 * v) = dp_v/dq
-
-  Eigen::Matrix<double, 3, 6> jacobian(Eigen::Index v) const { return J.middleRows<3>(3 * v); }
-};
-
-/// get_vertex_jacobians_compact, in Scalar = double or float (the float32
-/// transport: the double values rounded to float32). J_v = [ Jr_v | I3 ]:
-/// only the rotation block Jr_v = dp_v/d(phi, theta, psi) is sent.
-template <typename Scalar>
-struct VertexRotationJacobians
-{
-  using StackedRotationJacobians = Eigen::Matrix<Scalar, Eigen::Dynamic, 3, Eigen::RowMajor>;
-  Eigen::Matrix<Scalar, 3, Eigen::Dynamic> positions;  ///< [m] column v = vertex v in the fixed frame
-  StackedRotationJacobians Jr;  ///< 3N x 3; Jr.middleRows<3>(3 * v) = Jr_v; 0 x 3 with positions_only
-
-  Eigen::Matrix<Scalar, 3, 3> rotationJacobian(Eigen::Index v) const { return Jr.template middleRows<3>(3 * v); }
-};
-
 class RigidBodyClient
 {
 public:
@@ -140,78 +55,38 @@ public:
   {
     diff_rigid_body::GetBodies srv;
     call(get_bodies_, "get_bodies", srv);
-    Bodies out;
-    out.fixed_frame = srv.response.fixed_frame;
-    out.names = srv.response.names;
-    out.masses = srv.response.masses;
-    out.vertex_counts = srv.response.vertex_counts;
-    out.dofs = srv.response.dofs;
-    for (std::size_t i = 0; i < out.names.size(); ++i)
-    {
-      out.inertias.push_back(Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(
-          srv.response.inertias.data() + 9 * i));
-      out.com_offsets.push_back(Eigen::Map<const Eigen::Vector3d>(srv.response.com_offsets.data() + 3 * i));
-    }
-    std::size_t joint = 0;
-    for (std::uint32_t count : srv.response.joint_counts)
-    {
-      out.joint_names.emplace_back(srv.response.joint_names.begin() + joint,
-                                   srv.response.joint_names.begin() + joint + count);
-      joint += count;
-    }
-    std::size_t link = 0;
-    for (std::uint32_t count : srv.response.link_counts)
-    {
-      std::vector<Link> links;
-      std::uint32_t first_vertex = 0;
-      for (std::uint32_t k = 0; k < count; ++k, ++link)
-      {
-        Link l;
-        l.name = srv.response.link_names[link];
-        l.mass = srv.response.link_masses[link];
-        l.inertia = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(
-            srv.response.link_inertias.data() + 9 * link);
-        l.com_offset = Eigen::Map<const Eigen::Vector3d>(srv.response.link_com_offsets.data() + 3 * link);
-        l.first_vertex = first_vertex;
-        l.vertex_count = srv.response.link_vertex_counts[link];
-        first_vertex += l.vertex_count;
-        links.push_back(std::move(l));
-      }
-      out.links.push_back(std::move(links));
-    }
-    return out;
+    return toBodies(srv.response);
   }
 
   /// States of `bodies` (empty = all), in the node's order.
-  std::vector<std::pair<std::string, Vector6d>> getState(const std::vector<std::string>& bodies = {})
+  BodyStates getState(const std::vector<std::string>& bodies = {})
   {
     diff_rigid_body::GetState srv;
     srv.request.bodies = bodies;
     call(get_state_, "get_state", srv);
-    std::vector<std::pair<std::string, Vector6d>> out;
+    BodyStates out;
     for (const auto& state : srv.response.states)
-      out.emplace_back(state.name, Eigen::Map<const Vector6d>(state.q.data()));
+      out.emplace_back(state.name, Eigen::Map<const Eigen::VectorXd>(state.q.data(), state.q.size()));
     return out;
   }
 
-  /// All or nothing.
-  void setState(const std::vector<std::pair<std::string, Vector6d>>& states)
+  /// All or nothing. (name, q) pairs of free bodies, or (name, x) pairs of any
+  /// bodies (e.g. a BodyStates).
+  void setState(const std::vector<std::pair<std::string, Vector6d>>& states) { requestSetState(states); }
+  template <typename Vector, typename = std::enable_if_t<!std::is_same<Vector, Vector6d>::value>>
+  void setState(const std::vector<std::pair<std::string, Vector>>& states)
   {
-    diff_rigid_body::SetState srv;
-    for (const auto& named : states)
-    {
-      diff_rigid_body::BodyState state;
-      state.name = named.first;
-      Eigen::Map<Vector6d>(state.q.data()) = named.second;
-      srv.request.states.push_back(state);
-    }
-    call(set_state_, "set_state", srv);
+    requestSetState(states);
   }
-  void setState(const std::string& body, const Vector6d& q) { setState({ { body, q } }); }
+  template <typename Derived>
+  void setState(const std::string& body, const Eigen::MatrixBase<Derived>& x)
+  {
+    setState(std::vector<std::pair<std::string, Eigen::VectorXd>>{ { body, x } });
+  }
 
-  /// M(q) of `bodies` (empty = all). `q`: empty = the current state, else K
-  /// configurations of the n bodies, K*6*n values (configuration k, body i at
-  /// (k*n + i)*6). The node's state is not changed.
+  /// M(x) of `bodies` (empty = all). `q`: empty = the current state, else K
+  /// configurations, each the concatenation of the n bodies' x (K*6*n values
+  /// for free bodies). The node's state is not changed.
   MassMatrices massMatrices(const std::vector<std::string>& bodies = {}, const std::vector<double>& q = {},
                             bool derivatives = false)
   {
@@ -220,84 +95,77 @@ public:
     srv.request.q = q;
     srv.request.derivatives = derivatives;
     call(get_mass_matrix_, "get_mass_matrix", srv);
-    const auto& r = srv.response;
-    MassMatrices out;
-    out.bodies = r.bodies;
-    const std::size_t count = r.mass_matrices.size() / 36;
-    out.configurations = out.bodies.empty() ? 0 : count / out.bodies.size();
-    out.M.reserve(count);
-    for (std::size_t m = 0; m < count; ++m)
-      out.M.push_back(Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>>(r.mass_matrices.data() + 36 * m));
-    if (derivatives)
-    {
-      out.dM.resize(count);
-      for (std::size_t m = 0; m < count; ++m)
-        for (int j = 0; j < 6; ++j)
-          out.dM[m][j] =
-              Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>>(r.derivatives.data() + 216 * m + 36 * j);
-    }
-    out.cos_theta = r.cos_theta;
-    return out;
+    return toMassMatrices(srv.response, derivatives);
   }
 
-  /// M of one body at q (one configuration).
-  Matrix6d massMatrix(const std::string& body, const Vector6d& q)
+  /// M of one body at x (one configuration): d x d.
+  template <typename Derived>
+  Eigen::MatrixXd massMatrix(const std::string& body, const Eigen::MatrixBase<Derived>& x)
   {
-    return massMatrices({ body }, std::vector<double>(q.data(), q.data() + 6)).M.at(0);
+    return massMatrices({ body }, values(x)).M.at(0);
   }
 
-  /// Positions and J = dp/dq of `body`'s `vertices` (empty = all) at `q`
-  /// (nullptr = the current state).
+  /// Positions and J = dp/dx of `body`'s `vertices` (empty = all) at `q`
+  /// (nullptr = the current state) or at x.
   VertexJacobians vertexJacobians(const std::string& body, const Vector6d* q = nullptr,
                                   const std::vector<std::uint32_t>& vertices = {})
   {
     return requestVertexJacobians(body, vertices, optionalQ(q), 1).front();
   }
-  VertexJacobians vertexJacobians(const std::string& body, const Vector6d& q,
+  template <typename Derived>
+  VertexJacobians vertexJacobians(const std::string& body, const Eigen::MatrixBase<Derived>& x,
                                   const std::vector<std::uint32_t>& vertices = {})
   {
-    return vertexJacobians(body, &q, vertices);
+    return requestVertexJacobians(body, vertices, values(x), 1).front();
   }
   /// K configurations in one call: positions and J of `body`'s `vertices`
-  /// (empty = all) at each q of `qs`, block k for qs[k] (the same bits as a
+  /// (empty = all) at each x of `qs`, block k for qs[k] (the same bits as a
   /// call with qs[k] alone). The node's state is not changed.
   std::vector<VertexJacobians> vertexJacobians(const std::string& body, const std::vector<Vector6d>& qs,
                                                const std::vector<std::uint32_t>& vertices = {})
   {
     return requestVertexJacobians(body, vertices, flatten(qs), qs.size());
   }
+  std::vector<VertexJacobians> vertexJacobians(const std::string& body, const std::vector<Eigen::VectorXd>& qs,
+                                               const std::vector<std::uint32_t>& vertices = {})
+  {
+    return requestVertexJacobians(body, vertices, flatten(qs), qs.size());
+  }
 
-  /// dL/dq from dL/dp (3 x N, column v for vertex v) of `body`'s `vertices`
-  /// (empty = all) at `q` (nullptr = the current state). J is never formed.
-  Vector6d backprop(const std::string& body, const Eigen::Matrix3Xd& gradients, const Vector6d* q = nullptr,
-                    const std::vector<std::uint32_t>& vertices = {})
+  /// dL/dx (d values) from dL/dp (3 x N, column v for vertex v) of `body`'s
+  /// `vertices` (empty = all) at `q` (nullptr = the current state) or at x.
+  /// J is never formed.
+  Eigen::VectorXd backprop(const std::string& body, const Eigen::Matrix3Xd& gradients, const Vector6d* q = nullptr,
+                           const std::vector<std::uint32_t>& vertices = {})
   {
     return requestBackprop(body, vertices, { &gradients }, optionalQ(q), 1).front();
   }
-  Vector6d backprop(const std::string& body, const Eigen::Matrix3Xd& gradients, const Vector6d& q,
-                    const std::vector<std::uint32_t>& vertices = {})
+  template <typename Derived>
+  Eigen::VectorXd backprop(const std::string& body, const Eigen::Matrix3Xd& gradients,
+                           const Eigen::MatrixBase<Derived>& x, const std::vector<std::uint32_t>& vertices = {})
   {
-    return backprop(body, gradients, &q, vertices);
+    return requestBackprop(body, vertices, { &gradients }, values(x), 1).front();
   }
-  /// K configurations in one call: dL/dq at each q of `qs` from dL_dp[k]
+  /// K configurations in one call: dL/dx at each x of `qs` from dL_dp[k]
   /// (3 x N, column v for vertex v) at qs[k]; entry k has the same bits as a
   /// call with dL_dp[k] and qs[k] alone. dL_dp and qs have the same size.
   std::vector<Vector6d> backprop(const std::string& body, const std::vector<Eigen::Matrix3Xd>& dL_dp,
                                  const std::vector<Vector6d>& qs, const std::vector<std::uint32_t>& vertices = {})
   {
-    if (dL_dp.size() != qs.size())
-      throw std::invalid_argument("backprop: " + std::to_string(dL_dp.size()) + " gradient blocks for " +
-                                  std::to_string(qs.size()) + " configurations");
-    std::vector<const Eigen::Matrix3Xd*> blocks;
-    for (const Eigen::Matrix3Xd& gradients : dL_dp)
-      blocks.push_back(&gradients);
-    return requestBackprop(body, vertices, blocks, flatten(qs), qs.size());
+    const std::vector<Eigen::VectorXd> out = batchedBackprop(body, dL_dp, flatten(qs), qs.size(), vertices);
+    return std::vector<Vector6d>(out.begin(), out.end());
+  }
+  std::vector<Eigen::VectorXd> backprop(const std::string& body, const std::vector<Eigen::Matrix3Xd>& dL_dp,
+                                        const std::vector<Eigen::VectorXd>& qs,
+                                        const std::vector<std::uint32_t>& vertices = {})
+  {
+    return batchedBackprop(body, dL_dp, flatten(qs), qs.size(), vertices);
   }
 
-  /// The reduced transport of vertexJacobians: positions and the rotation
-  /// blocks Jr (none with `positions_only`) of `body`'s `vertices` (empty =
-  /// all) at `q` (nullptr = the current state). Scalar = float asks the node
-  /// for the float32 fields (single_precision).
+  /// The reduced transport of vertexJacobians: positions and the columns
+  /// of J that are not always I3 (none with `positions_only`) of `body`'s
+  /// `vertices` (empty = all) at `q` (nullptr = the current state) or at x.
+  /// Scalar = float asks the node for the float32 fields (single_precision).
   template <typename Scalar = double>
   VertexRotationJacobians<Scalar> vertexJacobiansCompact(const std::string& body, const Vector6d* q = nullptr,
                                                          const std::vector<std::uint32_t>& vertices = {},
@@ -305,17 +173,17 @@ public:
   {
     return requestCompact<Scalar>(body, vertices, optionalQ(q), 1, positions_only).front();
   }
-  template <typename Scalar = double>
-  VertexRotationJacobians<Scalar> vertexJacobiansCompact(const std::string& body, const Vector6d& q,
+  template <typename Scalar = double, typename Derived>
+  VertexRotationJacobians<Scalar> vertexJacobiansCompact(const std::string& body, const Eigen::MatrixBase<Derived>& x,
                                                          const std::vector<std::uint32_t>& vertices = {},
                                                          bool positions_only = false)
   {
-    return vertexJacobiansCompact<Scalar>(body, &q, vertices, positions_only);
+    return requestCompact<Scalar>(body, vertices, values(x), 1, positions_only).front();
   }
   /// K configurations in one call: block k for qs[k], as vertexJacobians.
-  template <typename Scalar = double>
+  template <typename Scalar = double, typename Vector>
   std::vector<VertexRotationJacobians<Scalar>> vertexJacobiansCompact(const std::string& body,
-                                                                      const std::vector<Vector6d>& qs,
+                                                                      const std::vector<Vector>& qs,
                                                                       const std::vector<std::uint32_t>& vertices = {},
                                                                       bool positions_only = false)
   {
@@ -351,6 +219,20 @@ private:
       throw ServiceError(server_ + "/" + service, srv.response.message);
   }
 
+  template <typename Vector>
+  void requestSetState(const std::vector<std::pair<std::string, Vector>>& states)
+  {
+    diff_rigid_body::SetState srv;
+    for (const auto& named : states)
+    {
+      diff_rigid_body::BodyState state;
+      state.name = named.first;
+      state.q = values(named.second);
+      srv.request.states.push_back(std::move(state));
+    }
+    call(set_state_, "set_state", srv);
+  }
+
   /// get_vertex_jacobians with `q` holding K configurations (or empty: the current state, K = 1).
   std::vector<VertexJacobians> requestVertexJacobians(const std::string& body,
                                                       const std::vector<std::uint32_t>& vertices,
@@ -363,19 +245,33 @@ private:
     call(get_vertex_jacobians_, "get_vertex_jacobians", srv);
     const auto& r = srv.response;
     const Eigen::Index n = vertexCount(r.positions.size(), K);
+    const Eigen::Index d = n ? static_cast<Eigen::Index>(r.jacobians.size() / (3 * n * K)) : 0;
     std::vector<VertexJacobians> out(K);
     for (std::size_t k = 0; k < K; ++k)
     {
       out[k].positions = Eigen::Map<const Eigen::Matrix3Xd>(r.positions.data() + 3 * n * k, 3, n);
-      out[k].J = Eigen::Map<const StackedJacobians>(r.jacobians.data() + 18 * n * k, 3 * n, 6);
+      out[k].J = Eigen::Map<const StackedJacobians>(r.jacobians.data() + 3 * n * d * k, 3 * n, d);
     }
     return out;
   }
 
+  std::vector<Eigen::VectorXd> batchedBackprop(const std::string& body, const std::vector<Eigen::Matrix3Xd>& dL_dp,
+                                               std::vector<double> q, std::size_t K,
+                                               const std::vector<std::uint32_t>& vertices)
+  {
+    if (dL_dp.size() != K)
+      throw std::invalid_argument("backprop: " + std::to_string(dL_dp.size()) + " gradient blocks for " +
+                                  std::to_string(K) + " configurations");
+    std::vector<const Eigen::Matrix3Xd*> blocks;
+    for (const Eigen::Matrix3Xd& gradients : dL_dp)
+      blocks.push_back(&gradients);
+    return requestBackprop(body, vertices, blocks, std::move(q), K);
+  }
+
   /// backprop with one 3 x N gradient block per configuration of `q`.
-  std::vector<Vector6d> requestBackprop(const std::string& body, const std::vector<std::uint32_t>& vertices,
-                                        const std::vector<const Eigen::Matrix3Xd*>& dL_dp, std::vector<double> q,
-                                        std::size_t K)
+  std::vector<Eigen::VectorXd> requestBackprop(const std::string& body, const std::vector<std::uint32_t>& vertices,
+                                               const std::vector<const Eigen::Matrix3Xd*>& dL_dp,
+                                               std::vector<double> q, std::size_t K)
   {
     diff_rigid_body::Backprop srv;
     srv.request.body = body;
@@ -385,9 +281,10 @@ private:
                                    gradients->data() + gradients->size());
     srv.request.q = std::move(q);
     call(backprop_, "backprop", srv);
-    std::vector<Vector6d> out(K);
+    const Eigen::Index d = static_cast<Eigen::Index>(srv.response.gradient.size() / K);
+    std::vector<Eigen::VectorXd> out(K);
     for (std::size_t k = 0; k < K; ++k)
-      out[k] = Eigen::Map<const Vector6d>(srv.response.gradient.data() + 6 * k);
+      out[k] = Eigen::Map<const Eigen::VectorXd>(srv.response.gradient.data() + d * k, d);
     return out;
   }
 
@@ -412,31 +309,37 @@ private:
     const std::vector<Scalar>& jacobians = compactField<Scalar>(r.rotation_jacobians, r.rotation_jacobians_f32);
     const Eigen::Index n = vertexCount(positions.size(), K);
     const Eigen::Index rows = positions_only ? 0 : 3 * n;
+    const Eigen::Index columns = rows ? static_cast<Eigen::Index>(jacobians.size() / (rows * K)) : 0;
     std::vector<VertexRotationJacobians<Scalar>> out(K);
     for (std::size_t k = 0; k < K; ++k)
     {
       out[k].positions = Eigen::Map<const Eigen::Matrix<Scalar, 3, Eigen::Dynamic>>(positions.data() + 3 * n * k, 3, n);
       out[k].Jr = Eigen::Map<const typename VertexRotationJacobians<Scalar>::StackedRotationJacobians>(
-          jacobians.data() + 3 * rows * k, rows, 3);
+          jacobians.data() + rows * columns * k, rows, columns);
     }
     return out;
   }
 
-  /// A single request's q: empty (the current state) or the 6 values of *q.
-  static std::vector<double> optionalQ(const Vector6d* q)
+  /// The values of one configuration x.
+  template <typename Derived>
+  static std::vector<double> values(const Eigen::MatrixBase<Derived>& x)
   {
-    return q ? std::vector<double>(q->data(), q->data() + 6) : std::vector<double>();
+    const Eigen::VectorXd evaluated = x;
+    return std::vector<double>(evaluated.data(), evaluated.data() + evaluated.size());
   }
 
-  /// The 6 K values of a batched request's q (K >= 1: an empty q would mean the current state).
-  static std::vector<double> flatten(const std::vector<Vector6d>& qs)
+  /// A single request's q: empty (the current state) or the 6 values of *q.
+  static std::vector<double> optionalQ(const Vector6d* q) { return q ? values(*q) : std::vector<double>(); }
+
+  /// The values of K configurations, concatenated (K >= 1: an empty q would mean the current state).
+  template <typename Vector>
+  static std::vector<double> flatten(const std::vector<Vector>& qs)
   {
     if (qs.empty())
       throw std::invalid_argument("qs: at least one configuration");
     std::vector<double> q;
-    q.reserve(6 * qs.size());
-    for (const Vector6d& one : qs)
-      q.insert(q.end(), one.data(), one.data() + 6);
+    for (const Vector& one : qs)
+      q.insert(q.end(), one.data(), one.data() + one.size());
     return q;
   }
 

@@ -1,6 +1,6 @@
 #include "rigid_body_server.h"
 
-#include "bounded_request.h"
+#include "server_helpers.h"
 
 #include <algorithm>
 #include <cstring>
@@ -8,55 +8,18 @@
 #include <geometry_msgs/TransformStamped.h>
 #include <tf2_msgs/TFMessage.h>
 
+#include "diff_rigid_body/articulated_kinematics.h"
 #include "diff_rigid_body/exceptions.h"
 #include "diff_rigid_body/state_file.h"
 
 namespace diff_rigid_body
 {
+using node::appendMatrix;
+using node::serve;
+using node::setTransform;
+
 namespace
 {
-// `pose` as a tf transform: its translation [m], and its rotation as a unit
-// quaternion (x, y, z, w).
-void setTransform(const Eigen::Isometry3d& pose, geometry_msgs::Transform& transform)
-{
-  transform.translation.x = pose.translation().x();
-  transform.translation.y = pose.translation().y();
-  transform.translation.z = pose.translation().z();
-  const Eigen::Quaterniond rotation(pose.linear());
-  transform.rotation.x = rotation.x();
-  transform.rotation.y = rotation.y();
-  transform.rotation.z = rotation.z();
-  transform.rotation.w = rotation.w();
-}
-
-// Runs `work`; a core error becomes success=false with its message, so that
-// the client receives it and nothing else happens. Returns true for roscpp.
-template <typename Response, typename Work>
-bool serve(Response& response, const char* service, Work&& work)
-{
-  try
-  {
-    work();
-    response.success = true;
-    response.message = "";
-  }
-  catch (const Error& e)
-  {
-    response = Response();
-    response.success = false;
-    response.message = e.what();
-    ROS_DEBUG_STREAM(service << ": refused: " << e.what());
-  }
-  catch (const std::exception& e)  // e.g. std::bad_alloc: report, keep serving
-  {
-    response = Response();
-    response.success = false;
-    response.message = std::string("internal error: ") + e.what();
-    ROS_ERROR_STREAM(service << ": " << response.message);
-  }
-  return true;
-}
-
 // The state to start from: the state file's when it holds a valid state of
 // this scene, else the URDF's (an unusable file is set aside with a warning).
 // The result is saved at once, so that an unwritable ~state_file stops the
@@ -89,44 +52,12 @@ SceneState initialState(const SceneQueries& queries, const std::string& state_fi
   return state;
 }
 
-// Appends `matrix` row-major to `out`.
-template <typename Matrix>
-void appendMatrix(const Matrix& matrix, std::vector<double>& out)
-{
-  for (Eigen::Index r = 0; r < matrix.rows(); ++r)
-    for (Eigen::Index c = 0; c < matrix.cols(); ++c)
-      out.push_back(matrix(r, c));
-}
-
-// Advertises `handler` for the service Srv with bounded request decoding
-// (bounded_request.h): a request refused there gets success=false and the
-// refusal, and never reaches the handler.
-template <typename Srv, typename Server>
-ros::ServiceServer advertiseBounded(ros::NodeHandle& nh, const std::string& name,
-                                    bool (Server::*handler)(typename Srv::Request&, typename Srv::Response&),
-                                    Server* server)
-{
-  using Bounded = BoundedRequest<typename Srv::Request>;
-  using Response = typename Srv::Response;
-  const boost::function<bool(Bounded&, Response&)> callback = [server, handler, name](Bounded& bounded,
-                                                                                      Response& response) {
-    if (bounded.refusal.empty())
-      return (server->*handler)(bounded.request, response);
-    response = Response();
-    response.success = false;
-    response.message = bounded.refusal;
-    ROS_DEBUG_STREAM(name << ": refused: " << bounded.refusal);
-    return true;
-  };
-  return nh.advertiseService<Bounded, Response>(name, callback);
-}
-
 std::vector<NamedState> toNamedStates(const std::vector<BodyState>& states)
 {
   std::vector<NamedState> named;
   named.reserve(states.size());
   for (const BodyState& state : states)
-    named.push_back({ state.name, Eigen::Map<const Vector6<double>>(state.q.data()) });
+    named.push_back({ state.name, Eigen::Map<const Eigen::VectorXd>(state.q.data(), static_cast<Eigen::Index>(state.q.size())) });
   return named;
 }
 }  // namespace
@@ -149,12 +80,13 @@ RigidBodyServer::RigidBodyServer(ros::NodeHandle& nh, ros::NodeHandle& private_n
   const bool benchmark_services = private_nh.param("benchmark_services", false);
 #define DRB_ADVERTISE(name, srv_type, handler, python_method, cpp_method, benchmark_only)                              \
   if (!(benchmark_only) || benchmark_services)                                                                         \
-    services_.push_back(advertiseBounded<srv_type>(private_nh, #name, &RigidBodyServer::handler, this));
+    services_.push_back(node::advertiseBounded<srv_type>(private_nh, #name, &RigidBodyServer::handler, this));
   DIFF_RIGID_BODY_SERVICES(DRB_ADVERTISE)
 #undef DRB_ADVERTISE
   // After the services: a client that sees ~set_states subscribed sees every service.
   set_states_subscriber_ = private_nh.subscribe("set_states", 100, &RigidBodyServer::onSetStates, this,
                                                 ros::TransportHints().tcpNoDelay());
+  joint_states_subscriber_ = nh.subscribe("joint_states", 10, &RigidBodyServer::onJointStates, this);
   timer_ = private_nh.createTimer(ros::Duration(1.0 / settings.publish_rate), &RigidBodyServer::onTimer, this);
 }
 
@@ -164,11 +96,11 @@ RigidBodyServer::StatePtr RigidBodyServer::snapshot() const
   return state_;
 }
 
-void RigidBodyServer::applyStates(const std::vector<BodyState>& states)
+void RigidBodyServer::commit(const std::function<SceneState(const SceneState&)>& change)
 {
   std::lock_guard<std::mutex> write(write_mutex_);
   const StatePtr previous = snapshot();
-  auto next = std::make_shared<const SceneState>(queries_.applyStates(*previous, toNamedStates(states)));
+  auto next = std::make_shared<const SceneState>(change(*previous));
   if (!state_file_.empty())
     writeStateFile(state_file_, queries_.scene(), *next);  // durable before it is visible or acknowledged
   {
@@ -177,6 +109,11 @@ void RigidBodyServer::applyStates(const std::vector<BodyState>& states)
   }
   updateOutgoingMessages(*previous, *next);
   publishState(ros::Time::now(), /*state_changed=*/true);
+}
+
+void RigidBodyServer::applyStates(const std::vector<BodyState>& states)
+{
+  commit([&](const SceneState& current) { return queries_.applyStates(current, toNamedStates(states)); });
 }
 
 void RigidBodyServer::initOutgoingMessages(const SceneState& state)
@@ -205,19 +142,36 @@ void RigidBodyServer::initOutgoingMessages(const SceneState& state)
 void RigidBodyServer::updateOutgoingMessages(const SceneState& previous, const SceneState& next)
 {
   for (std::size_t i = 0; i < next.size(); ++i)
-    if (std::memcmp(previous[i].data(), next[i].data(), sizeof(double) * 6) != 0)
+    if (previous[i].size() != next[i].size() ||
+        std::memcmp(previous[i].data(), next[i].data(), sizeof(double) * static_cast<std::size_t>(next[i].size())) != 0)
       writeBodyToOutgoingMessages(i, next[i]);
 }
 
-void RigidBodyServer::writeBodyToOutgoingMessages(std::size_t body_index, const Vector6<double>& q)
+void RigidBodyServer::writeBodyToOutgoingMessages(std::size_t body_index, const Eigen::VectorXd& x)
 {
   const SceneBody& body = queries_.scene().bodies[body_index];
-  // Link l of the body: X_fixed_link = X_fixed_bodylink(q) * X_bodylink_link.
-  const Eigen::Isometry3d link_pose = linkPoseFromState(q, body.body.com_offset);
-  for (std::size_t l = 0; l < body.links.size(); ++l)
-    setTransform(link_pose * body.links[l].pose_in_body_link,
-                 body_transforms_[first_transform_of_body_[body_index] + l].transform);
-  std::copy(q.data(), q.data() + 6, states_message_.states[body_index].q.begin());
+  geometry_msgs::TransformStamped* transforms = &body_transforms_[first_transform_of_body_[body_index]];
+  if (body.articulated)
+  {
+    // Link l: X_fixed_link = X_fixed_segment(x) * X_segment_link.
+    const ArticulatedPose<double> pose = articulatedPose<double>(*body.articulated, x.data());
+    for (std::size_t l = 0; l < body.links.size(); ++l)
+    {
+      const SegmentFrame<double>& frame = pose.frames[body.links[l].segment];
+      Eigen::Isometry3d segment_pose = Eigen::Isometry3d::Identity();
+      segment_pose.linear() = frame.R;
+      segment_pose.translation() = frame.p;
+      setTransform(segment_pose * body.links[l].pose_in_body_link, transforms[l].transform);
+    }
+  }
+  else
+  {
+    // Link l: X_fixed_link = X_fixed_bodylink(q) * X_bodylink_link.
+    const Eigen::Isometry3d link_pose = linkPoseFromState(Vector6<double>(x.head<6>()), body.body.com_offset);
+    for (std::size_t l = 0; l < body.links.size(); ++l)
+      setTransform(link_pose * body.links[l].pose_in_body_link, transforms[l].transform);
+  }
+  states_message_.states[body_index].q.assign(x.data(), x.data() + x.size());
 }
 
 void RigidBodyServer::publishState(const ros::Time& stamp, bool state_changed)
@@ -266,9 +220,17 @@ bool RigidBodyServer::getBodies(GetBodies::Request&, GetBodies::Response& respon
       response.masses.push_back(body.mass);
       appendMatrix(body.inertia_body, response.inertias);
       appendMatrix(body.com_offset, response.com_offsets);
-      response.vertex_counts.push_back(static_cast<std::uint32_t>(body.vertices.cols()));
-      response.dofs.push_back(6);
-      response.joint_counts.push_back(0);
+      response.vertex_counts.push_back(static_cast<std::uint32_t>(scene_body.vertexCount()));
+      response.dofs.push_back(static_cast<std::uint32_t>(scene_body.dofs()));
+      if (const std::shared_ptr<const ArticulatedBody>& tree = scene_body.articulated)
+      {
+        response.joint_counts.push_back(static_cast<std::uint32_t>(tree->joint_names.size()));
+        response.joint_names.insert(response.joint_names.end(), tree->joint_names.begin(), tree->joint_names.end());
+        response.joint_lower.insert(response.joint_lower.end(), tree->joint_lower.begin(), tree->joint_lower.end());
+        response.joint_upper.insert(response.joint_upper.end(), tree->joint_upper.begin(), tree->joint_upper.end());
+      }
+      else
+        response.joint_counts.push_back(0);
       response.link_counts.push_back(static_cast<std::uint32_t>(scene_body.links.size()));
       for (const LinkInBody& link : scene_body.links)
       {
@@ -294,7 +256,7 @@ bool RigidBodyServer::getState(GetState::Request& request, GetState::Response& r
     {
       BodyState state;
       state.name = named.name;
-      std::copy(named.q.data(), named.q.data() + 6, state.q.begin());
+      state.q.assign(named.q.data(), named.q.data() + named.q.size());
       response.states.push_back(std::move(state));
     }
   });
@@ -305,6 +267,7 @@ bool RigidBodyServer::getMassMatrix(GetMassMatrix::Request& request, GetMassMatr
   return serve(response, "get_mass_matrix", [&] {
     MassMatrixAnswer answer = queries_.massMatrices(*snapshot(), request.bodies, request.q, request.derivatives);
     response.bodies = std::move(answer.bodies);
+    response.dofs = std::move(answer.dofs);
     response.mass_matrices = std::move(answer.mass_matrices);
     response.derivatives = std::move(answer.derivatives);
     response.cos_theta = std::move(answer.cos_theta);
@@ -337,6 +300,25 @@ void RigidBodyServer::onSetStates(const BodyStateArray::ConstPtr& message)
   catch (const Error& e)
   {
     ROS_WARN_STREAM_THROTTLE(1.0, "set_states: message dropped: " << e.what());
+  }
+}
+
+void RigidBodyServer::onJointStates(const sensor_msgs::JointState::ConstPtr& message)
+{
+  try
+  {
+    commit([&](const SceneState& current) {
+      std::vector<std::string> unknown;
+      SceneState next = queries_.applyJointPositions(current, message->name, message->position, unknown);
+      for (const std::string& name : unknown)  // under the writer mutex, which guards the set
+        if (unknown_joints_logged_.insert(name).second)
+          ROS_WARN_STREAM("joint_states: ignoring joint '" << name << "', which no body has (logged once)");
+      return next;
+    });
+  }
+  catch (const Error& e)
+  {
+    ROS_WARN_STREAM_THROTTLE(1.0, "joint_states: message dropped: " << e.what());
   }
 }
 

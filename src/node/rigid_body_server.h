@@ -16,16 +16,23 @@
 // Publication (tf and ~states) happens under the writer mutex, at
 // ~publish_rate and after every accepted change, from messages kept equal to
 // the current state: frame ids and names are written once at start, a state
-// change rewrites the entries of the bodies whose q changed, and a periodic
+// change rewrites the entries of the bodies whose x changed, and a periodic
 // tick only restamps. A tick therefore costs O(links) stores plus what
 // tf2_ros and roscpp do with the messages, with no quaternion or string work.
 // roscpp drops a non-latched message that has no subscriber, so a tick skips
 // /tf (the restamp and tf2_ros's copy into a TFMessage) while /tf has no
 // subscriber: the traffic is the same, and a new subscriber gets the next tick.
+//
+// State changes come from set_state, ~set_states and joint_states
+// (sensor_msgs/JointState, as robot_state_publisher reads it): each goes
+// through commit(), so each is validated whole, saved, swapped in and
+// published the same way.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <string>
 
 #include <ros/ros.h>
@@ -34,6 +41,7 @@
 
 #include <diff_rigid_body/BodyStateArray.h>
 #include <geometry_msgs/TransformStamped.h>
+#include <sensor_msgs/JointState.h>
 
 #include "diff_rigid_body/scene_queries.h"
 #include "diff_rigid_body_ros/services.h"
@@ -63,15 +71,21 @@ private:
   using StatePtr = std::shared_ptr<const SceneState>;
 
   StatePtr snapshot() const;
+  /// Under the writer mutex: next = change(current) (throws to refuse, all
+  /// or nothing), saved to ~state_file if set, swapped in, then published.
+  void commit(const std::function<SceneState(const SceneState&)>& change);
   /// Validates and applies named states (all or nothing), then publishes them.
   void applyStates(const std::vector<BodyState>& states);
   /// Writes the frame ids and names of the outgoing messages, and their
-  /// transforms and q from `state` (once, at start).
+  /// transforms and x from `state` (once, at start).
   void initOutgoingMessages(const SceneState& state);
-  /// Rewrites the transforms and q of the bodies whose q differs (bitwise)
+  /// Rewrites the transforms and x of the bodies whose x differs (bitwise)
   /// between `previous` and `next`.
   void updateOutgoingMessages(const SceneState& previous, const SceneState& next);
-  void writeBodyToOutgoingMessages(std::size_t body_index, const Vector6<double>& q);
+  /// Body i's link frames from x: a free body's link l at
+  /// X(q) * pose_in_body_link; an articulated body's at
+  /// X_segment(x) * pose_in_body_link, X_segment from articulatedPose.
+  void writeBodyToOutgoingMessages(std::size_t body_index, const Eigen::VectorXd& x);
   /// Restamps the outgoing messages and publishes them: all body link frames
   /// on /tf in one message (when /tf has a subscriber), and the states on
   /// ~states. Without a ~states subscriber, ~states goes out only if
@@ -92,6 +106,10 @@ private:
   bool ping(Ping::Request& request, Ping::Response& response);
   bool echo(Echo::Request& request, Echo::Response& response);
   void onSetStates(const BodyStateArray::ConstPtr& message);
+  /// joint_states: named joints set, unknown names ignored (each logged
+  /// once), a message with a non-finite position or fewer positions than
+  /// names dropped whole with a warning.
+  void onJointStates(const sensor_msgs::JointState::ConstPtr& message);
   void onTimer(const ros::TimerEvent& event);
 
   const SceneQueries queries_;
@@ -115,6 +133,9 @@ private:
   tf2_ros::StaticTransformBroadcaster static_broadcaster_;
   ros::Publisher states_publisher_;
   ros::Subscriber set_states_subscriber_;
+  ros::Subscriber joint_states_subscriber_;
+  /// Unknown joint names already logged (guarded by write_mutex_).
+  std::set<std::string> unknown_joints_logged_;
   std::vector<ros::ServiceServer> services_;
   ros::Timer timer_;
 };

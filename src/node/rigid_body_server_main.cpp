@@ -52,7 +52,9 @@ drb::SceneOptions readSceneOptions(const ros::NodeHandle& private_nh)
   options.bodies = readBodies(private_nh);
   options.strict_inertia = private_nh.param("strict_inertia", false);
   const std::string joints = private_nh.param<std::string>("joints", "model");
-  if (joints != "model" && joints != "free")
+  if (joints == "free")
+    options.joints = drb::JointHandling::Free;
+  else if (joints != "model")
     throw drb::SceneDescriptionError("parameter ~joints: must be 'model' or 'free', got '" + joints + "'");
   options.fixed_frame = private_nh.param<std::string>("fixed_frame", "");
   options.find_package = [](const std::string& package) { return ros::package::getPath(package); };
@@ -102,17 +104,22 @@ int main(int argc, char** argv)
     ROS_FATAL_STREAM("rigid_body_server: cannot load the scene: " << e.what());
     return 1;
   }
-  if (!scene.unmodelled_joints.empty() && private_nh.param<std::string>("joints", "model") == "model")
-    ROS_WARN("rigid_body_server: ~joints 'model' (articulated bodies) is not implemented yet: the children of "
-             "1-dof joints are free bodies, as with ~joints: free");
+  // With ~joints: model only planar joints are left unmodelled, which interface.md asks to warn about;
+  // with ~joints: free every 1-dof joint is, by request.
+  const bool free_joints = private_nh.param<std::string>("joints", "model") == "free";
   for (const std::string& joint : scene.unmodelled_joints)
-    ROS_INFO_STREAM("rigid_body_server: " << joint);
+  {
+    if (free_joints)
+      ROS_INFO_STREAM("rigid_body_server: " << joint);
+    else
+      ROS_WARN_STREAM("rigid_body_server: " << joint);
+  }
   for (const std::string& warning : scene.warnings)
     ROS_WARN_STREAM("rigid_body_server: " << warning);
 
   std::ostringstream summary;
   for (const drb::SceneBody& body : scene.bodies)
-    summary << " " << body.body.name << " (" << body.body.vertices.cols() << " vertices)";
+    summary << " " << body.body.name << " (" << body.dofs() << " coordinates, " << body.vertexCount() << " vertices)";
   ROS_INFO_STREAM("rigid_body_server: serving " << scene.bodies.size() << " bodies in '" << scene.fixed_frame
                                                 << "':" << summary.str());
 

@@ -37,6 +37,7 @@ class Node:
         params = dict(params or {})
         if robot_description is None and 'urdf_path' not in params:
             params['urdf_path'] = SCENE
+        params.setdefault('joints', 'free')  # version 1: gamma (revolute) is a free body
         for name, value in params.items():
             if value is not None:
                 rospy.set_param(self.ns + '/rigid_body_server/' + name, value)

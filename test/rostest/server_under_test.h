@@ -55,8 +55,7 @@ inline drb::BodyState bodyState(const std::string& name, const Vector6d& q)
 {
   drb::BodyState state;
   state.name = name;
-  for (int i = 0; i < 6; ++i)
-    state.q[i] = q[i];
+  state.q.assign(q.data(), q.data() + 6);
   return state;
 }
 
@@ -64,7 +63,11 @@ inline NamedStates namedStates(const std::vector<drb::BodyState>& states)
 {
   NamedStates out;
   for (const drb::BodyState& state : states)
+  {
+    if (state.q.size() != 6)  // a free body's x is q (6 values)
+      throw std::runtime_error("state of '" + state.name + "' has " + std::to_string(state.q.size()) + " values, not 6");
     out.emplace_back(state.name, Eigen::Map<const Vector6d>(state.q.data()));
+  }
   return out;
 }
 

@@ -182,6 +182,7 @@ TEST_F(Services, GetBodiesAgainstIndependentMassProperties)
 TEST_F(Services, AgreesWithCoreLibraryOnTheSameUrdf)
 {
   diff_rigid_body::SceneOptions options;
+  options.joints = diff_rigid_body::JointHandling::Free;  // as services.test runs the node (~joints: free)
   options.find_package = [](const std::string& package) { return ros::package::getPath(package); };
   const diff_rigid_body::Scene scene = diff_rigid_body::loadSceneFromUrdfFile(fixtureUrdfPath(), options);
   const diff_rigid_body_ros::Bodies bodies = server().bodies();
