@@ -7,19 +7,22 @@
 //   diff_rigid_body state file v1
 //   fingerprint <16 hex digits>            sceneFingerprint() of the scene
 //   bodies <n>
-//   body <name> <q0> <q1> <q2> <q3> <q4> <q5>     n lines, scene order
+//   body <name> <x0> ... <x_{d-1}>          n lines, scene order, d = the body's dofs
 //   end <n> crc32 <8 hex digits>
 //
 //   - <name> is the body name percent-encoded: every byte outside '!'..'~',
 //     and '%' itself, becomes %XX (upper-case hex), so a name is one token;
-//   - <qi> is q = (phi, theta, psi, tx, ty, tz) as C99 hexadecimal floats
+//   - <xi> is the body's x (SceneState): q = (phi, theta, psi, tx, ty, tz)
+//     for a free body (the 6 values of version 1's lines), the coordinates of
+//     articulated_body.h for an articulated one; C99 hexadecimal floats
 //     ("%a", e.g. 0x1.921fb54442d18p+1), which round-trip bit for bit;
 //   - the CRC-32 (IEEE 802.3, as zlib's crc32) covers every byte before the
 //     "end" line.
 //
 // A file is accepted only if every line parses, the counts agree, the CRC
-// matches, nothing follows the trailer, every value is finite, and the
-// fingerprint and the body names equal the scene's. Anything else is a
+// matches, nothing follows the trailer, every value is finite, the
+// fingerprint and the body names equal the scene's, and every body line has
+// its body's dofs. Anything else is a
 // StateFileError saying what was wrong; there is no partial read.
 #pragma once
 
@@ -45,15 +48,20 @@ std::size_t maxStateFileSize(std::size_t body_count);
 
 /// 64-bit FNV-1a over what the state means for a scene: the fixed frame and,
 /// per body in order, its name, mass, inertia, COM offset and body-frame
-/// vertices (their IEEE bits). A different value means a state saved for
-/// another scene would put the bodies somewhere else.
+/// vertices (their IEEE bits), and for an articulated body its tree: per
+/// segment its link, parent, joint (name, motion, origin, axis, coordinate,
+/// mimic factors), mass properties and vertex range, then its vertices and
+/// joint names. A scene of free bodies has version 1's fingerprint. A
+/// different value means a state saved for another scene would put the
+/// bodies somewhere else.
 std::uint64_t sceneFingerprint(const Scene& scene);
 
 /// CRC-32 (IEEE 802.3 polynomial, reflected, as zlib's crc32()).
 std::uint32_t crc32(const std::string& bytes);
 
-/// The file text for `state` (one q per scene body, in scene order).
-/// Throws StateFileError if the sizes differ or a value is not finite.
+/// The file text for `state` (one x per scene body, in scene order).
+/// Throws StateFileError if the sizes (bodies, or a body's dofs) differ or a
+/// value is not finite.
 std::string formatStateFile(const Scene& scene, const SceneState& state);
 
 /// The state in `text`, checked against `scene` (see the header comment).

@@ -51,6 +51,49 @@ private:
   std::uint64_t hash_ = 0xcbf29ce484222325ULL;
 };
 
+void hashPoints(const Matrix3X<double>& points, Fnv1a& hash)
+{
+  hash.number(static_cast<std::uint64_t>(points.cols()));
+  for (Eigen::Index i = 0; i < points.size(); ++i)
+    hash.number(points.data()[i]);
+}
+
+// What places an articulated body's vertices at x: its tree, every joint
+// (name, type, origin, axis, coordinate, mimic factors), the segments' mass
+// properties and vertex ranges, the vertices and the joint names in x order.
+void hashArticulated(const ArticulatedBody& body, Fnv1a& hash)
+{
+  hash.text("articulated");
+  hash.number(static_cast<std::uint64_t>(body.floating_root));
+  hash.number(static_cast<std::uint64_t>(body.segments.size()));
+  for (const Segment& segment : body.segments)
+  {
+    hash.text(segment.link);
+    hash.number(static_cast<std::uint64_t>(static_cast<std::int64_t>(segment.parent)));
+    hash.text(segment.joint);
+    hash.number(static_cast<std::uint64_t>(segment.motion == JointMotion::Prismatic));
+    for (int i = 0; i < 9; ++i)
+      hash.number(segment.origin.linear()(i / 3, i % 3));
+    for (int i = 0; i < 3; ++i)
+      hash.number(segment.origin.translation()[i]);
+    for (int i = 0; i < 3; ++i)
+      hash.number(segment.axis[i]);
+    hash.number(static_cast<std::uint64_t>(static_cast<std::int64_t>(segment.coordinate)));
+    hash.number(segment.multiplier);
+    hash.number(segment.offset);
+    hash.number(segment.mass_properties.mass);
+    for (int i = 0; i < 3; ++i)
+      hash.number(segment.mass_properties.com[i]);
+    for (int i = 0; i < 9; ++i)
+      hash.number(segment.mass_properties.inertia(i / 3, i % 3));
+    hash.number(static_cast<std::uint64_t>(segment.vertex_begin));
+    hash.number(static_cast<std::uint64_t>(segment.vertex_count));
+  }
+  hashPoints(body.vertices, hash);
+  hash.number(static_cast<std::uint64_t>(body.joint_names.size()));
+  for (const std::string& name : body.joint_names)
+    hash.text(name);
+}
 }  // namespace
 
 using namespace detail;
@@ -79,6 +122,8 @@ std::uint64_t sceneFingerprint(const Scene& scene)
     for (Eigen::Index v = 0; v < body.vertices.cols(); ++v)
       for (int i = 0; i < 3; ++i)
         hash.number(body.vertices(i, v));
+    if (scene_body.articulated)  // nothing more for a free body: version 1's fingerprint
+      hashArticulated(*scene_body.articulated, hash);
   }
   return hash.value();
 }
@@ -105,12 +150,17 @@ std::string formatStateFile(const Scene& scene, const SceneState& state)
   text += "bodies " + std::to_string(state.size()) + "\n";
   for (std::size_t i = 0; i < state.size(); ++i)
   {
-    text += "body " + encodeName(scene.bodies[i].body.name);
-    for (int k = 0; k < 6; ++k)
+    const std::string& name = scene.bodies[i].body.name;
+    const std::size_t dofs = scene.bodies[i].dofs();
+    if (static_cast<std::size_t>(state[i].size()) != dofs)
+      fail("cannot save " + std::to_string(state[i].size()) + " values for body '" + name + "' of " +
+           std::to_string(dofs) + " dofs");
+    text += "body " + encodeName(name);
+    for (std::size_t k = 0; k < dofs; ++k)
     {
-      if (!std::isfinite(state[i][k]))
-        fail("cannot save a non-finite q[" + std::to_string(k) + "] of body '" + scene.bodies[i].body.name + "'");
-      text += " " + formatValue(state[i][k]);
+      if (!std::isfinite(state[i][static_cast<Eigen::Index>(k)]))
+        fail("cannot save a non-finite q[" + std::to_string(k) + "] of body '" + name + "'");
+      text += " " + formatValue(state[i][static_cast<Eigen::Index>(k)]);
     }
     text += "\n";
   }
@@ -192,22 +242,33 @@ std::uint64_t parseCounts(const Lines& lines, std::size_t end_count)
   return fingerprint;
 }
 
-/// One "body <name> <6 hex floats>" line (line number `number`).
-NamedState parseBodyLine(const std::string& line, std::size_t number)
+/// "expected 'body <name> <d hex floats>'" for a line of `d` values.
+std::string expectedBodyLine(const std::string& where, std::size_t dofs, const std::string& line)
+{
+  return where + ": expected 'body <name> <" + std::to_string(dofs) + " hex floats>', got '" + quoted(line) + "'";
+}
+
+/// One "body <name> <hex floats>" line (line number `number`): any number
+/// of values (at least one), checked against the body's dofs once the names
+/// are known to be the scene's. `dofs` is the scene's for this line, for
+/// the message of a line without values.
+NamedState parseBodyLine(const std::string& line, std::size_t number, std::size_t dofs)
 {
   const std::string where = "line " + std::to_string(number);
   const std::vector<std::string> tokens = splitTokens(line);
-  if (tokens.size() != 8 || tokens[0] != "body")
-    fail(where + ": expected 'body <name> <6 hex floats>', got '" + quoted(line) + "'");
+  if (tokens.size() < 3 || tokens[0] != "body")
+    fail(expectedBodyLine(where, dofs, line));
   NamedState body;
   if (!decodeName(tokens[1], body.name) || body.name.empty())
     fail(where + ": malformed body name '" + quoted(tokens[1]) + "'");
-  for (int k = 0; k < 6; ++k)
+  body.q.resize(static_cast<Eigen::Index>(tokens.size() - 2));
+  for (std::size_t k = 0; k + 2 < tokens.size(); ++k)
   {
-    if (!parseValue(tokens[2 + k], body.q[k]))
+    double& value = body.q[static_cast<Eigen::Index>(k)];
+    if (!parseValue(tokens[2 + k], value))
       fail(where + ": q[" + std::to_string(k) + "] of body '" + quoted(body.name) + "': not a hex float: '" +
            quoted(tokens[2 + k], 40) + "'");
-    if (!std::isfinite(body.q[k]))
+    if (!std::isfinite(value))
       fail(where + ": q[" + std::to_string(k) + "] of body '" + quoted(body.name) + "': not finite");
   }
   return body;
@@ -246,11 +307,15 @@ SceneState parseStateFile(const std::string& text, const Scene& scene)
   state.reserve(count);
   for (std::size_t i = 0; i < count; ++i)
   {
-    NamedState body = parseBodyLine(lines.text[i + 3], i + 4);
+    NamedState body = parseBodyLine(lines.text[i + 3], i + 4, i < scene.bodies.size() ? scene.bodies[i].dofs() : 6);
     file_names.push_back(std::move(body.name));
-    state.push_back(body.q);
+    state.push_back(std::move(body.q));
   }
   checkSameScene(file_names, fingerprint, scene);
+  // Same bodies in the same order: each line has its body's dofs.
+  for (std::size_t i = 0; i < count; ++i)
+    if (static_cast<std::size_t>(state[i].size()) != scene.bodies[i].dofs())
+      fail(expectedBodyLine("line " + std::to_string(i + 4), scene.bodies[i].dofs(), lines.text[i + 3]));
   return state;
 }
 

@@ -40,13 +40,15 @@ inline std::size_t entriesIn(const std::string& folder)
   return n;
 }
 
-/// Same number of bodies and every q equal bit for bit (-0 and NaN payloads count).
+/// Same number of bodies, each x of the same length and equal bit for bit
+/// (-0 and NaN payloads count).
 inline bool bitwiseEqual(const diff_rigid_body::SceneState& a, const diff_rigid_body::SceneState& b)
 {
   if (a.size() != b.size())
     return false;
   for (std::size_t i = 0; i < a.size(); ++i)
-    if (std::memcmp(a[i].data(), b[i].data(), sizeof(double) * 6) != 0)
+    if (a[i].size() != b[i].size() ||
+        std::memcmp(a[i].data(), b[i].data(), sizeof(double) * static_cast<std::size_t>(a[i].size())) != 0)
       return false;
   return true;
 }

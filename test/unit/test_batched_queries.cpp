@@ -11,9 +11,11 @@
 
 #include <gtest/gtest.h>
 
+#include "diff_rigid_body/articulated_queries.h"
 #include "diff_rigid_body/exceptions.h"
 #include "diff_rigid_body/scene_queries.h"
 #include "../support/expect_throws.h"
+#include "../support/plumbing_scenes.h"
 #include "../support/urdf_builders.h"
 
 namespace drb = diff_rigid_body;
@@ -98,7 +100,7 @@ std::size_t selected(const drb::SceneQueries& queries, const std::string& body,
                      const std::vector<std::uint32_t>& vertices)
 {
   const std::size_t index = queries.bodyIndex(body, "body");
-  return vertices.empty() ? static_cast<std::size_t>(queries.body(index).vertices.cols()) : vertices.size();
+  return vertices.empty() ? queries.scene().bodies[index].vertexCount() : vertices.size();
 }
 
 // Every answer of a K-configuration request equals the K single requests, bit for bit.
@@ -279,4 +281,155 @@ TEST(BatchedQueries, RefusalsNameTheConfigurationOrTheValue)
   const std::size_t at = message.find(")[");
   ASSERT_NE(at, std::string::npos);
   EXPECT_GE(std::stoul(message.substr(at + 2)), 6u) << message;
+}
+
+// ---------------------------------------------------------------------------
+// Articulated bodies (plumbing_scenes.h): K configurations of d values; each
+// block is the bits of the direct articulated_* call and of its single request.
+namespace
+{
+/// K configurations of body `index`: a floating root's 6 from the table, then joint values.
+std::vector<double> articulatedConfigurations(const drb::SceneQueries& queries, std::size_t index, std::size_t K)
+{
+  const drb::ArticulatedBody& body = *queries.scene().bodies[index].articulated;
+  const std::vector<double> roots = configurations(K);
+  std::vector<double> q;
+  for (std::size_t k = 0; k < K; ++k)
+  {
+    if (body.floating_root)
+      q.insert(q.end(), roots.begin() + 6 * k, roots.begin() + 6 * k + 6);
+    for (std::size_t j = 0; j < body.joint_names.size(); ++j)
+      q.push_back(std::sin(1.3 * static_cast<double>(k) + static_cast<double>(j)) * (k == 4 ? 1e6 : 1.0));
+  }
+  return q;
+}
+
+void expectArticulatedBlocks(const drb::SceneQueries& queries, const std::string& name,
+                             const std::vector<std::uint32_t>& vertices, std::size_t K)
+{
+  const drb::SceneState current = queries.initialState();
+  const std::size_t index = queries.bodyIndex(name, "body");
+  const drb::ArticulatedBody& body = *queries.scene().bodies[index].articulated;
+  const std::size_t d = body.dofs(), N = selected(queries, name, vertices), w = queries.compactColumns(index);
+  const std::vector<double> q = articulatedConfigurations(queries, index, K);
+  const std::string where = name + ", K = " + std::to_string(K) + ", N = " + std::to_string(N);
+
+  std::vector<double> P, J, Pr, Jr;
+  std::vector<float> Pf, Jf, Po, none{ 1.0f };
+  queries.vertexJacobians(current, name, vertices, q, P, J);
+  queries.vertexRotationJacobians<double>(current, name, vertices, q, false, Pr, Jr);
+  queries.vertexRotationJacobians<float>(current, name, vertices, q, false, Pf, Jf);
+  queries.vertexRotationJacobians<float>(current, name, vertices, q, true, Po, none);
+  ASSERT_EQ(P.size(), 3 * N * K) << where;
+  ASSERT_EQ(J.size(), 3 * d * N * K) << where;
+  ASSERT_EQ(Jr.size(), 3 * w * N * K) << where;
+  EXPECT_TRUE(none.empty()) << where;
+  expectSameBits(Pr.data(), P.data(), P.size(), "compact positions, " + where);
+  expectSameBits(Po.data(), Pf.data(), Pf.size(), "positions_only f32, " + where);
+  const std::vector<double> g = someGradients(3 * N * K);
+  const std::vector<double> dL = queries.backpropConfigurations(current, name, vertices, g, q);
+  ASSERT_EQ(dL.size(), d * K) << where;
+  // The compact columns: all but x[3..5] with a floating root, else all.
+  std::vector<std::size_t> columns;
+  for (std::size_t c = 0; c < d; ++c)
+    if (!body.floating_root || c < 3 || c > 5)
+      columns.push_back(c);
+  ASSERT_EQ(columns.size(), w) << where;
+
+  for (std::size_t k = 0; k < K; ++k)
+  {
+    const std::string at = where + ", configuration " + std::to_string(k);
+    const std::vector<double> qk = slice(q, d * k, d);
+    std::vector<double> p0(3 * N), j0(3 * d * N), dL0(d);
+    const drb::ArticulatedPose<double> pose = drb::articulatedPose(body, qk.data());
+    drb::articulatedVertexJacobians(body, pose, vertices, {}, p0.data(), j0.data());
+    drb::articulatedBackprop(body, pose, vertices, g.data() + 3 * N * k, dL0.data());
+    expectSameBits(P.data() + 3 * N * k, p0.data(), 3 * N, "positions vs articulatedVertexJacobians, " + at);
+    expectSameBits(J.data() + 3 * d * N * k, j0.data(), 3 * d * N, "jacobians vs articulatedVertexJacobians, " + at);
+    expectSameBits(dL.data() + d * k, dL0.data(), d, "backprop vs articulatedBackprop, " + at);
+    for (std::size_t n = 0; n < N; ++n)
+      for (std::size_t r = 0; r < 3; ++r)
+        for (std::size_t c = 0; c < w; ++c)
+        {
+          const double full = J[3 * d * N * k + 3 * d * n + d * r + columns[c]];
+          const std::size_t at_compact = 3 * w * N * k + 3 * w * n + w * r + c;
+          expectSameBits(&Jr[at_compact], &full, 1, "compact J column " + std::to_string(columns[c]) + ", " + at);
+          const float rounded = static_cast<float>(full);
+          expectSameBits(&Jf[at_compact], &rounded, 1, "compact f32 J, " + at);
+        }
+    std::vector<double> p1, j1;
+    queries.vertexJacobians(current, name, vertices, qk, p1, j1);
+    expectSameBits(P.data() + 3 * N * k, p1.data(), 3 * N, "positions vs single request, " + at);
+    expectSameBits(J.data() + 3 * d * N * k, j1.data(), 3 * d * N, "jacobians vs single request, " + at);
+    const Eigen::VectorXd single = queries.backprop(current, name, vertices, slice(g, 3 * N * k, 3 * N), qk);
+    ASSERT_EQ(static_cast<std::size_t>(single.size()), d) << at;
+    expectSameBits(dL.data() + d * k, single.data(), d, "backprop vs single request, " + at);
+  }
+}
+}  // namespace
+
+TEST(BatchedQueries, ArticulatedBlocksAreTheDirectCallsBitForBit)
+{
+  const drb::SceneQueries queries(drb_test::plumbing::scene());
+  for (std::size_t K : { 1u, 2u, 7u })
+    for (const char* body : { "arm", "crane" })
+    {
+      expectArticulatedBlocks(queries, body, {}, K);
+      expectArticulatedBlocks(queries, body, { 4, 0, 4, 2 }, K);
+    }
+  expectArticulatedBlocks(queries, "arm", { 13, 12, 3, 7 }, 2);  // the finger (mimic) and the slider
+  // The current state when q is empty.
+  const drb::SceneState current = queries.initialState();
+  std::vector<double> now_p, now_j, at_p, at_j;
+  queries.vertexJacobians(current, "arm", {}, {}, now_p, now_j);
+  queries.vertexJacobians(current, "arm", {}, std::vector<double>(current[2].data(), current[2].data() + 9), at_p,
+                          at_j);
+  ASSERT_EQ(now_j.size(), 14u * 27u);
+  expectSameBits(now_j.data(), at_j.data(), now_j.size(), "arm jacobians at the current state");
+}
+
+TEST(BatchedQueries, ArticulatedRefusals)
+{
+  const drb::SceneQueries queries(drb_test::plumbing::scene());
+  const drb::SceneState current = queries.initialState();
+  std::vector<double> positions{ 42.0 }, jacobians{ 43.0 };
+  std::vector<float> positions_f32{ 44.0f }, jacobians_f32{ 45.0f };
+  DRB_EXPECT_THROWS_MESSAGE((queries.vertexJacobians(current, "arm", {}, std::vector<double>(10, 0.0), positions,
+                                                     jacobians)),
+                            drb::InvalidArgumentError,
+                            "q: expected 9 values per configuration (9 K for K configurations, or empty for the "
+                            "current state), got 10 values");
+  DRB_EXPECT_THROWS_MESSAGE((queries.vertexJacobians(current, "crane", { 1, 5 }, {}, positions, jacobians)),
+                            drb::InvalidArgumentError,
+                            "vertices[1]: index 5 out of range for body 'crane' with 5 vertices");
+  DRB_EXPECT_THROWS_MESSAGE((queries.backprop(current, "crane", { 1 }, { 1, 2, 3 }, std::vector<double>(6, 0.0))),
+                            drb::InvalidArgumentError, "q: expected 2 values (or empty for the current state), got 6");
+  // The slide (axis (1, 1, 0)/sqrt 2) at 1.7e308 with the root at x = 1.7e308:
+  // the slider's frame overflows in configuration 1.
+  std::vector<double> q = articulatedConfigurations(queries, 2, 2);
+  q[9 + 3] = 1.7e308;
+  q[9 + 8] = 1.7e308;
+  const char* kOverflow = "q (configuration 1): position too large: vertex positions of body 'arm' would overflow";
+  DRB_EXPECT_THROWS_MESSAGE((queries.vertexJacobians(current, "arm", {}, q, positions, jacobians)),
+                            drb::InvalidArgumentError, kOverflow);
+  DRB_EXPECT_THROWS_MESSAGE((queries.vertexRotationJacobians<double>(current, "arm", { 0 }, q, true, positions,
+                                                                     jacobians)),
+                            drb::InvalidArgumentError, kOverflow);
+  DRB_EXPECT_THROWS_MESSAGE((queries.backpropConfigurations(current, "arm", { 0 }, std::vector<double>(6, 1.0), q)),
+                            drb::InvalidArgumentError, kOverflow);
+  // The boom out at 3.5e38 m along x: finite in double, beyond float32.
+  const std::vector<double> far = { 0.0, 3.5e38 };
+  queries.vertexJacobians(current, "crane", {}, far, positions, jacobians);
+  for (double value : positions)
+    EXPECT_TRUE(std::isfinite(value));
+  positions = { 42.0 };
+  jacobians = { 43.0 };
+  DRB_EXPECT_THROWS_MESSAGE((queries.vertexRotationJacobians<float>(current, "crane", {}, far, false, positions_f32,
+                                                                    jacobians_f32)),
+                            drb::InvalidArgumentError,
+                            "q: position too large: vertex positions of body 'crane' would overflow float32");
+  EXPECT_EQ(positions, std::vector<double>{ 42.0 });
+  EXPECT_EQ(jacobians, std::vector<double>{ 43.0 });
+  EXPECT_EQ(positions_f32, std::vector<float>{ 44.0f });
+  EXPECT_EQ(jacobians_f32, std::vector<float>{ 45.0f });
 }

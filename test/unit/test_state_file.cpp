@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -16,6 +17,7 @@
 #include "diff_rigid_body/state_file.h"
 #include "diff_rigid_body/urdf_scene.h"
 #include "../support/expect_throws.h"
+#include "../support/plumbing_scenes.h"
 #include "../support/state_files.h"
 #include "../support/urdf_builders.h"
 
@@ -41,7 +43,7 @@ std::string twoBodyUrdf(const std::string& second_name = "ball", const std::stri
 // subnormal, huge and tiny magnitudes.
 drb::SceneState awkwardState()
 {
-  drb::SceneState state(2);
+  drb::SceneState state(2, Eigen::VectorXd(6));
   state[0] << 0.1, -0.0, 3.141592653589793, 1e-310, -1.7976931348623157e308, 2.2250738585072014e-308;
   state[1] << -1.0 / 3.0, std::nextafter(1.0, 2.0), 1e300, -5e-324, 0.0, 123456.789;
   return state;
@@ -61,7 +63,7 @@ TEST(StateFile, RoundTripIsBitExact)
 TEST(StateFile, DocumentedFormat)
 {
   const drb::Scene scene = drb::loadSceneFromUrdf(twoBodyUrdf());
-  drb::SceneState state(2, drb::Vector6<double>::Zero());
+  drb::SceneState state(2, Eigen::VectorXd::Zero(6));
   state[0] << 1.5, -2.0, 0.0, -0.0, 0.1, 1.0;
   const std::string text = drb::formatStateFile(scene, state);
   std::istringstream lines(text);
@@ -221,4 +223,61 @@ TEST(StateFile, DurableWriteAndRead)
   DRB_EXPECT_THROWS_MESSAGE(drb::readStateFile(path, scene), drb::StateFileError, "too large");
   std::remove(path.c_str());
   ::rmdir(folder.c_str());
+}
+
+// Free scenes keep version 1's fingerprint (values of the version 1 code),
+// so that their state files still load.
+TEST(StateFile, FreeSceneFingerprintsAreVersion1s)
+{
+  EXPECT_EQ(drb::sceneFingerprint(drb::loadSceneFromUrdf(twoBodyUrdf())), 0xbc940bca4f53be20ull);
+  EXPECT_EQ(drb::sceneFingerprint(drb::loadSceneFromUrdf(drb_test::urdf::twoBodies())), 0x2dcad80891de5090ull);
+}
+
+// Articulated bodies: a line of d values per body, round trips bit for bit,
+// and a file of another robot (one joint different) is refused.
+TEST(StateFile, ArticulatedBodiesRoundTripAndAreFingerprinted)
+{
+  const drb::Scene scene = drb_test::plumbing::scene();
+  drb::SceneState state;
+  for (const drb::SceneBody& body : scene.bodies)
+    state.push_back(body.initial_state);
+  state[2][8] = -0.0;
+  state[3][1] = 5e-324;
+  const std::string text = drb::formatStateFile(scene, state);
+  EXPECT_NE(text.find("\nbody arm 0x1.999999999999ap-4 0x1.999999999999ap-3 0x1.3333333333333p-2 0x1p+0 0x1p+1 "
+                      "0x1.8p+1 0x1.999999999999ap-2 -0x1p-1 -0x0p+0\n"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("\nbody crane 0x1.6666666666666p-1 0x0.0000000000001p-1022\n"), std::string::npos) << text;
+  EXPECT_TRUE(drb_test::bitwiseEqual(drb::parseStateFile(text, scene), state)) << text;
+
+  // Each change below moves the robot's vertices for the same x: another fingerprint.
+  const auto changed = [](const std::function<void(drb::ArticulatedBody&)>& change) {
+    std::shared_ptr<drb::ArticulatedBody> arm = drb_test::plumbing::arm();
+    change(*arm);
+    return drb_test::plumbing::scene(arm);
+  };
+  const std::vector<std::pair<std::string, drb::Scene>> others = {
+    { "origin", changed([](drb::ArticulatedBody& b) { b.segments[2].origin.translation()[0] += 1e-12; }) },
+    { "axis", changed([](drb::ArticulatedBody& b) { b.segments[1].axis = -b.segments[1].axis; }) },
+    { "motion", changed([](drb::ArticulatedBody& b) { b.segments[3].motion = drb::JointMotion::Revolute; }) },
+    { "mimic", changed([](drb::ArticulatedBody& b) { b.segments[4].multiplier = 0.5; }) },
+    { "mass", changed([](drb::ArticulatedBody& b) { b.segments[1].mass_properties.mass *= 2; }) },
+    { "vertex", changed([](drb::ArticulatedBody& b) { b.vertices(1, 13) += 1e-9; }) },
+    { "joint", changed([](drb::ArticulatedBody& b) { b.segments[1].joint = "hip"; }) },
+    { "tree", changed([](drb::ArticulatedBody& b) { b.segments[4].parent = 1; }) },
+  };
+  for (const auto& other : others)
+  {
+    EXPECT_NE(drb::sceneFingerprint(other.second), drb::sceneFingerprint(scene)) << other.first;
+    DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(text, other.second), drb::StateFileError,
+                              "saved for another scene");
+  }
+  // A line with the wrong number of values for its body, its checksum fixed up.
+  const std::string short_crane = reseal(withoutTrailer(drb_test::replacedOnce(text, " 0x0.0000000000001p-1022\n", "\n")), 4);
+  DRB_EXPECT_THROWS_MESSAGE(drb::parseStateFile(short_crane, scene), drb::StateFileError,
+                            "line 7: expected 'body <name> <2 hex floats>', got 'body crane 0x1.6666666666666p-1'");
+  state[3].resize(3);
+  DRB_EXPECT_THROWS_MESSAGE(drb::formatStateFile(scene, state), drb::StateFileError,
+                            "cannot save 3 values for body 'crane' of 2 dofs");
 }
