@@ -152,14 +152,16 @@ void setState(FuzzedDataProvider& in, drb::SceneState& current)
     require(index >= 0, "set_state accepted an unknown body");
     require(!updated[index], "set_state accepted a repeated body");
     updated[index] = true;
-    require(std::memcmp(next[index].data(), update.q.data(), sizeof(double) * 6) == 0,
+    require(next[index].size() == update.q.size() &&
+                std::memcmp(next[index].data(), update.q.data(), sizeof(double) * update.q.size()) == 0,
             "set_state did not store q bit for bit");
   }
   for (std::size_t i = 0; i < next.size(); ++i)
   {
-    requireAllFinite(next[i].data(), 6, "state");
+    require(static_cast<std::size_t>(next[i].size()) == queries().dofs(i), "state: wrong length");
+    requireAllFinite(next[i].data(), next[i].size(), "state");
     if (!updated[i])
-      require(std::memcmp(next[i].data(), current[i].data(), sizeof(double) * 6) == 0,
+      require(std::memcmp(next[i].data(), current[i].data(), sizeof(double) * next[i].size()) == 0,
               "set_state changed a body it was not given");
   }
   current = next;
@@ -199,11 +201,18 @@ void getMassMatrix(FuzzedDataProvider& in, const drb::SceneState& current)
   {
     const drb::MassMatrixAnswer answer = queries().massMatrices(current, names, q, derivatives);
     const std::size_t n = names.empty() ? current.size() : names.size();
-    const std::size_t matrices = q.empty() ? n : q.size() / 6;
-    require(answer.bodies.size() == n, "get_mass_matrix: wrong body count");
-    require(answer.mass_matrices.size() == 36 * matrices, "get_mass_matrix: wrong matrix count");
-    require(answer.cos_theta.size() == matrices, "get_mass_matrix: wrong cos_theta count");
-    require(answer.derivatives.size() == (derivatives ? 216 * matrices : 0), "get_mass_matrix: wrong derivatives");
+    std::size_t D = 0, per_m = 0, per_dm = 0;
+    for (std::uint32_t d : answer.dofs)
+    {
+      D += d;
+      per_m += d * d;
+      per_dm += d * d * d;
+    }
+    const std::size_t K = q.empty() ? 1 : q.size() / D;
+    require(answer.bodies.size() == n && answer.dofs.size() == n, "get_mass_matrix: wrong body count");
+    require(answer.mass_matrices.size() == per_m * K, "get_mass_matrix: wrong matrix count");
+    require(answer.cos_theta.size() == n * K, "get_mass_matrix: wrong cos_theta count");
+    require(answer.derivatives.size() == (derivatives ? per_dm * K : 0), "get_mass_matrix: wrong derivatives");
     requireAllFinite(answer.mass_matrices.data(), answer.mass_matrices.size(), "mass_matrices");
     requireAllFinite(answer.derivatives.data(), answer.derivatives.size(), "derivatives");
     requireAllFinite(answer.cos_theta.data(), answer.cos_theta.size(), "cos_theta");
@@ -228,10 +237,15 @@ std::vector<double> fuzzedQ(FuzzedDataProvider& in)
   return fuzzedDoubles(in, 20);
 }
 
-/// K of an accepted request's q: 1 when empty (the current state), else its size / 6.
-std::size_t configurationsOf(const std::vector<double>& q)
+/// K of an accepted request's q for body `index`: 1 when empty (the current state), else its size / dofs.
+std::size_t configurationsOf(const std::vector<double>& q, int index)
 {
-  return q.empty() ? 1 : q.size() / 6;
+  return q.empty() ? 1 : q.size() / queries().dofs(static_cast<std::size_t>(index));
+}
+
+std::size_t vertexCountOf(int index)
+{
+  return queries().scene().bodies[static_cast<std::size_t>(index)].vertexCount();
 }
 
 void getVertexJacobians(FuzzedDataProvider& in, const drb::SceneState& current)
@@ -253,20 +267,21 @@ void getVertexJacobians(FuzzedDataProvider& in, const drb::SceneState& current)
   const int index = drb_fuzz::findBody(queries().scene(), body);
   require(index >= 0, "get_vertex_jacobians accepted an unknown body");
   const std::size_t count =
-      vertices.empty() ? static_cast<std::size_t>(queries().body(index).vertices.cols()) : vertices.size();
-  const std::size_t K = configurationsOf(q);
-  require(positions.size() == 3 * count * K && jacobians.size() == 18 * count * K,
+      vertices.empty() ? vertexCountOf(index) : vertices.size();
+  const std::size_t K = configurationsOf(q, index);
+  const std::size_t d = queries().dofs(static_cast<std::size_t>(index));
+  require(positions.size() == 3 * count * K && jacobians.size() == 3 * d * count * K,
           "get_vertex_jacobians: wrong sizes");
   requireAllFinite(positions.data(), positions.size(), "positions");
   requireAllFinite(jacobians.data(), jacobians.size(), "jacobians");
-  // Configuration k's block has the bits of a request with its 6 values alone.
+  // Configuration k's block has the bits of a request with its d values alone.
   for (std::size_t k = 0; K > 1 && k < K; ++k)
   {
     std::vector<double> p1, j1;
-    queries().vertexJacobians(current, body, vertices, std::vector<double>(q.begin() + 6 * k, q.begin() + 6 * k + 6),
+    queries().vertexJacobians(current, body, vertices, std::vector<double>(q.begin() + d * k, q.begin() + d * k + d),
                               p1, j1);
     require(std::memcmp(p1.data(), positions.data() + 3 * count * k, sizeof(double) * p1.size()) == 0 &&
-                std::memcmp(j1.data(), jacobians.data() + 18 * count * k, sizeof(double) * j1.size()) == 0,
+                std::memcmp(j1.data(), jacobians.data() + 3 * d * count * k, sizeof(double) * j1.size()) == 0,
             "get_vertex_jacobians: a configuration's block differs from its single request");
   }
 }
@@ -295,9 +310,10 @@ void vertexRotationJacobians(FuzzedDataProvider& in, const drb::SceneState& curr
   const int index = drb_fuzz::findBody(queries().scene(), body);
   require(index >= 0, "get_vertex_jacobians_compact accepted an unknown body");
   const std::size_t count =
-      vertices.empty() ? static_cast<std::size_t>(queries().body(index).vertices.cols()) : vertices.size();
-  const std::size_t K = configurationsOf(q);
-  require(positions.size() == 3 * count * K && rotation_jacobians.size() == (positions_only ? 0 : 9 * count * K),
+      vertices.empty() ? vertexCountOf(index) : vertices.size();
+  const std::size_t K = configurationsOf(q, index);
+  const std::size_t w = queries().compactColumns(static_cast<std::size_t>(index));
+  require(positions.size() == 3 * count * K && rotation_jacobians.size() == (positions_only ? 0 : 3 * w * count * K),
           "get_vertex_jacobians_compact: wrong sizes");
   for (const std::vector<Out>* values : { &positions, &rotation_jacobians })
     for (std::size_t i = 0; i < values->size(); ++i)
@@ -315,8 +331,9 @@ void backprop(FuzzedDataProvider& in, const drb::SceneState& current)
   {
     // The expected size, so that the values are what is tested.
     const std::size_t count =
-        vertices.empty() ? static_cast<std::size_t>(queries().body(index).vertices.cols()) : vertices.size();
-    const std::size_t K = q.size() >= 6 ? q.size() / 6 : 1;
+        vertices.empty() ? vertexCountOf(index) : vertices.size();
+    const std::size_t d = queries().dofs(static_cast<std::size_t>(index));
+    const std::size_t K = q.size() >= d ? q.size() / d : 1;
     gradients.resize(3 * count * K + (in.ConsumeIntegralInRange<int>(0, 7) == 0 ? 1 : 0));
     for (double& value : gradients)
       value = fuzzedDouble(in);
@@ -326,7 +343,9 @@ void backprop(FuzzedDataProvider& in, const drb::SceneState& current)
   try
   {
     const std::vector<double> gradient = queries().backpropConfigurations(current, body, vertices, gradients, q);
-    require(gradient.size() == 6 * configurationsOf(q), "backprop: wrong size");
+    const int index = drb_fuzz::findBody(queries().scene(), body);
+    require(gradient.size() == queries().dofs(static_cast<std::size_t>(index)) * configurationsOf(q, index),
+            "backprop: wrong size");
     requireAllFinite(gradient.data(), gradient.size(), "backprop gradient");
   }
   catch (const drb::InvalidArgumentError&)

@@ -43,11 +43,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     return 0;
   }
   drb_fuzz::require(state.size() == scene().bodies.size(), "parsed state has the wrong size");
-  for (const auto& q : state)
-    drb_fuzz::requireAllFinite(q.data(), 6, "parsed q");
+  for (std::size_t i = 0; i < state.size(); ++i)
+  {
+    drb_fuzz::require(static_cast<std::size_t>(state[i].size()) == scene().bodies[i].dofs(), "parsed x of wrong length");
+    drb_fuzz::requireAllFinite(state[i].data(), state[i].size(), "parsed q");
+  }
   const drb::SceneState again = drb::parseStateFile(drb::formatStateFile(scene(), state), scene());
   for (std::size_t i = 0; i < state.size(); ++i)
-    drb_fuzz::require(std::memcmp(state[i].data(), again[i].data(), sizeof(double) * 6) == 0,
+    drb_fuzz::require(std::memcmp(state[i].data(), again[i].data(), sizeof(double) * state[i].size()) == 0,
                       "format/parse round trip is not bit exact");
   return 0;
 }

@@ -104,8 +104,9 @@ void exerciseQueries(const drb::Scene& scene)
       drb_fuzz::requireAllFinite(positions.data(), positions.size(), "positions of " + name);
       drb_fuzz::requireAllFinite(jacobians.data(), jacobians.size(), "jacobians of " + name);
       const std::vector<double> gradients(positions.size(), 1.0);
-      const drb::Vector6<double> gradient = queries.backprop(state, name, {}, gradients, {});
-      drb_fuzz::requireAllFinite(gradient.data(), 6, "backprop of " + name);
+      const Eigen::VectorXd gradient = queries.backprop(state, name, {}, gradients, {});
+      drb_fuzz::require(static_cast<std::size_t>(gradient.size()) == queries.dofs(i), "backprop size of " + name);
+      drb_fuzz::requireAllFinite(gradient.data(), gradient.size(), "backprop of " + name);
     }
     catch (const drb::InvalidArgumentError&)
     {

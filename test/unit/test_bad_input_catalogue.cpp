@@ -33,6 +33,7 @@
 #include "diff_rigid_body/scene_queries.h"
 #include "diff_rigid_body/state_file.h"
 #include "diff_rigid_body/urdf_scene.h"
+#include "../support/plumbing_scenes.h"
 #include "../support/state_files.h"
 #include "../support/urdf_builders.h"
 
@@ -535,6 +536,18 @@ std::string compactOfBox(const std::string& size, const std::vector<double>& q)
   return std::to_string(positions.size() / 3) + " vertices";
 }
 
+// joint_states on the plumbing scene (arm: shoulder, elbow, slide, mimic finger_joint).
+std::string joints(const std::vector<std::string>& names, const std::vector<double>& positions)
+{
+  static const drb::SceneQueries queries(drb_test::plumbing::scene());
+  std::vector<std::string> unknown;
+  queries.applyJointPositions(queries.initialState(), names, positions, unknown);
+  std::string listed;
+  for (const std::string& name : unknown)
+    listed += (listed.empty() ? "" : ", ") + name;
+  return "unknown: " + listed;
+}
+
 std::vector<Row> requestRows()
 {
   const drb::SceneState current = twoBodies().initialState();
@@ -726,6 +739,20 @@ std::vector<Row> requestRows()
     { "R42", "get_vertex_jacobians_compact, single_precision: configuration 1 of 2 at a translation of 3.5e38",
       Expect::Refused, "InvalidArgumentError", "q (configuration 1): position too large",
       [] { return compactOfBox<float>("0.2 0.2 0.2", { 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, -3.5e38 }); } },
+    { "R43", "set_state: q of 5 values for a 6-dof body", Expect::Refused, "InvalidArgumentError",
+      "states[0].q (body 'cube'): expected 6 values (the body's dofs), got 5 values",
+      [=] { return set({ { "cube", Eigen::VectorXd::Zero(5) } }); } },
+    { "R44", "joint_states: a NaN position (the message is dropped whole)", Expect::Refused, "InvalidArgumentError",
+      "position[1] (joint 'slide'): not finite",
+      [] { return joints({ "elbow", "slide" }, { 0.5, kNaN }); } },
+    { "R45", "joint_states: 2 names, 1 position", Expect::Refused, "InvalidArgumentError",
+      "position: expected 2 values (one per name), got 1 values",
+      [] { return joints({ "elbow", "slide" }, { 0.5 }); } },
+    { "R46", "joint_states: unknown and mimic joint names", Expect::Accepted, "", "",
+      [] {
+        EXPECT_EQ(joints({ "ghost", "finger_joint", "elbow" }, { 1.0, 2.0, 3.0 }), "unknown: ghost");
+        return std::string("accepted: elbow set; finger_joint (mimic) ignored; ghost ignored and reported");
+      } },
   };
 }
 
