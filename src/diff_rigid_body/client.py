@@ -7,21 +7,33 @@ arrays. Response arrays are deserialised straight from the wire with
 arrays returned are read-only views on the received buffer; ``.copy()`` one
 to modify it.
 
-Shapes (n bodies, N vertices, K configurations; q = (phi, theta, psi, tx, ty, tz)):
+Shapes (n bodies, N vertices, K configurations). A body's coordinates x
+have d = dof values (``bodies().dofs``): a free body's x is
+q = (phi, theta, psi, tx, ty, tz), d = 6; an articulated body's x is its
+floating root's q (if it floats), then its joint positions (interface.md,
+"Version 2"). Every ``q`` argument holds x:
 
 ==============================  ===============================================
-``mass_matrix(...).M``          (n, 6, 6), or (K, n, 6, 6) for a batched ``q``
-``mass_matrix(...).dM``         (n, 6, 6, 6): ``dM[i, j]`` = dM/dq_j of body i
-                                (a 6x6 matrix); (K, n, 6, 6, 6) when batched
-``vertex_jacobians(...)``       positions (N, 3) [m], J (N, 3, 6): ``J[v]`` = dp_v/dq;
-                                (K, N, 3) and (K, N, 3, 6) for a q of shape (K, 6)
-``vertex_jacobians_compact()``  positions (N, 3) [m], Jr (N, 3, 3): ``Jr[v]`` =
-                                dp_v/d(phi, theta, psi), J = [Jr | I3]; float32
-                                with ``single_precision``; (K, N, 3), (K, N, 3, 3)
-                                for a q of shape (K, 6)
-``backprop(...)``               dL/dq, (6,); (K, 6) for a q of shape (K, 6)
-``get_state()``                 dict name -> q (6,)
+``mass_matrix(...).M``          (n, d, d), or (K, n, d, d) for a batched ``q``;
+                                when the bodies' d differ, a list of n arrays,
+                                (d_i, d_i) or (K, d_i, d_i)
+``mass_matrix(...).dM``         (n, d, d, d): ``dM[i, j]`` = dM/dx_j of body i
+                                (a d x d matrix); (K, n, d, d, d) when batched
+                                (a list per body when the d differ)
+``vertex_jacobians(...)``       positions (N, 3) [m], J (N, 3, d): ``J[v]`` = dp_v/dx;
+                                (K, N, 3) and (K, N, 3, d) for a q of shape (K, d)
+``vertex_jacobians_compact()``  positions (N, 3) [m], Jr (N, 3, c): the columns
+                                of J that are not always I3 (free body: c = 3,
+                                ``Jr[v]`` = dp_v/d(phi, theta, psi), J = [Jr | I3];
+                                floating root: c = d - 3; fixed base: c = d);
+                                float32 with ``single_precision``; (K, N, 3),
+                                (K, N, 3, c) for a q of shape (K, d)
+``backprop(...)``               dL/dx, (d,); (K, d) for a q of shape (K, d)
+``get_state()``                 dict name -> x (d,)
 ==============================  ===============================================
+
+A flat ``q`` of K d values (K > 1) is K configurations too; to tell, the
+client asks ``get_bodies`` once for the bodies' d (and again after a reconnection).
 
 A service that answers ``success: False`` raises :class:`DiffRigidBodyError`
 with the node's message. If a persistent connection drops (the node was
@@ -121,9 +133,10 @@ def _pose(q):
     return [] if q is None else _floats(q)
 
 
-def _configurations(q):
-    """K for a vertex request's q of shape (K, 6) (or 6K flat values, K > 1), or None for one
-    configuration (None, empty or (6,)). A size the node refuses is left to the node's message."""
+def _configurations(q, dofs):
+    """K for a vertex request's q of shape (K, d) (or K d flat values, K > 1), or None for one
+    configuration (None, empty or (d,)); ``dofs()`` gives d, asked only for a flat q. A size the
+    node refuses is left to the node's message."""
     if q is None:
         return None
     if np.ndim(q) >= 2:
@@ -131,17 +144,28 @@ def _configurations(q):
             raise ValueError('q: at least one configuration, got shape %s' % (np.shape(q),))
         return int(np.shape(q)[0])
     size = int(np.size(q))
-    return None if size in (0, 6) or size % 6 else size // 6
+    if size == 0:
+        return None
+    d = dofs()
+    return None if d == 0 or size == d or size % d else size // d
 
 
-def _blocks(values, configurations, shape):
-    """``values`` as (N,) + shape, or (K, N) + shape when ``configurations`` = K is not None."""
+def _blocks(values, configurations, vertices, columns=None):
+    """``values`` as (N, 3) (or (N, 3, columns)), with a leading K axis when ``configurations`` = K
+    is not None. ``vertices`` = N."""
+    shape = (vertices, 3) if columns is None else (vertices, 3, columns)
     values = np.asarray(values)
-    if configurations is None:
-        return values.reshape((-1,) + shape)
-    per_vertex = int(np.prod(shape))
-    vertices = values.size // (configurations * per_vertex) if configurations else 0
-    return values.reshape((configurations, vertices) + shape)
+    return values.reshape(shape if configurations is None else (configurations,) + shape)
+
+
+def _per_body(values, dofs, configurations, power):
+    """The matrices of a get_mass_matrix field (d_i^power values per matrix, configuration-major)
+    of each body, as a list of (K,) + (d_i,) * power arrays."""
+    sizes = [d ** power for d in dofs]
+    rows = np.asarray(values).reshape(configurations, sum(sizes))
+    starts = np.concatenate([[0], np.cumsum(sizes)]).astype(int)
+    return [rows[:, starts[i]:starts[i + 1]].reshape((configurations,) + (d,) * power)
+            for i, d in enumerate(dofs)]
 
 
 class RigidBodyClient(object):
@@ -170,6 +194,7 @@ class RigidBodyClient(object):
         self.server = rospy.resolve_name(server)
         self.timeout = timeout
         self._proxies = {}
+        self._dofs = None  # body name -> d, from get_bodies when first needed
 
     # ------------------------------------------------------------------ plumbing
     def _proxy(self, name):
@@ -182,6 +207,7 @@ class RigidBodyClient(object):
         return proxy
 
     def _drop(self, name):
+        self._dofs = None  # the node restarted: perhaps with another scene
         proxy = self._proxies.pop(name, None)
         if proxy is not None:
             proxy.close()
@@ -220,6 +246,16 @@ class RigidBodyClient(object):
     def __exit__(self, *exc):
         self.close()
 
+    def dofs(self, body):
+        """d = len(x) of ``body`` (``get_bodies``, asked once per connection); 0 for an unknown body."""
+        if self._dofs is None or body not in self._dofs:
+            answer = self.call('get_bodies')
+            self._dofs = dict(zip(answer.names, (int(d) for d in answer.dofs)))
+        return self._dofs.get(body, 0)
+
+    def _configurations(self, body, q):
+        return _configurations(q, lambda: self.dofs(body))
+
     # ------------------------------------------------------------------ services
     def bodies(self):
         """The scene: a :data:`Bodies` tuple."""
@@ -232,73 +268,93 @@ class RigidBodyClient(object):
                       _split(r.link_counts, _links(r)))
 
     def get_state(self, bodies=None):
-        """dict body name -> q (6,), in the node's order (``bodies`` None = all)."""
+        """dict body name -> x (d,), in the node's order (``bodies`` None = all)."""
         r = self.call('get_state', bodies=list(bodies or []))
         return collections.OrderedDict((s.name, np.asarray(s.q)) for s in r.states)
 
     def set_state(self, states):
-        """Sets states, all or nothing. ``states``: dict name -> q (6,), or
-        pairs (name, q)."""
+        """Sets states, all or nothing. ``states``: dict name -> x (d,), or
+        pairs (name, x)."""
         items = states.items() if hasattr(states, 'items') else states
         self.call('set_state', states=[BodyState(name=name, q=_floats(q)) for name, q in items])
 
     def mass_matrix(self, bodies=None, q=None, derivatives=False):
-        """M(q) of ``bodies`` (None = all), as :data:`MassMatrices`.
+        """M(x) of ``bodies`` (None = all), as :data:`MassMatrices`.
 
-        ``q``: None = the current state (M is (n, 6, 6)); an (n, 6) array
-        (or 6n values) = one configuration (M is (n, 6, 6)); a (K, n, 6) array =
-        K configurations in one call (M is (K, n, 6, 6)). The node's state is
-        not changed. With ``derivatives``, dM has one more axis of 6 after the
-        body axis: ``dM[..., i, j, :, :]`` = dM/dq_j of body i.
+        ``q``: None = the current state (M is (n, d, d)); an (n, d) array (or
+        the n bodies' x concatenated) = one configuration (M is (n, d, d)); a
+        (K, n, d) array, or K such concatenations (flat or (K, D)), = K
+        configurations in one call (M is (K, n, d, d)). The node's state is
+        not changed. With ``derivatives``, dM has one more axis of d after the
+        body axis: ``dM[..., i, j, :, :]`` = dM/dx_j of body i. When the
+        bodies' d differ, M and dM are lists with one array per body, without
+        the body axis: ``M[i]`` (d_i, d_i) or (K, d_i, d_i).
         """
-        batched = q is not None and np.ndim(q) == 3
         r = self.call('get_mass_matrix', bodies=list(bodies or []), q=_pose(q), derivatives=bool(derivatives))
-        n = len(r.bodies)
-        shape = (-1, n) if batched else (n,)
-        M = np.asarray(r.mass_matrices).reshape(shape + (6, 6))
-        dM = np.asarray(r.derivatives).reshape(shape + (6, 6, 6)) if derivatives else None
-        return MassMatrices(list(r.bodies), M, dM, np.asarray(r.cos_theta).reshape(shape))
+        n, dofs = len(r.bodies), [int(d) for d in r.dofs]
+        K = len(r.cos_theta) // n if n else 0
+        batched = (q is not None and np.ndim(q) == 3) or K > 1
+        shape = (K, n) if batched else (n,)
+        cos_theta = np.asarray(r.cos_theta).reshape(shape)
+        if len(set(dofs)) <= 1:
+            d = dofs[0] if dofs else 0
+            M = np.asarray(r.mass_matrices).reshape(shape + (d, d))
+            dM = np.asarray(r.derivatives).reshape(shape + (d, d, d)) if derivatives else None
+            return MassMatrices(list(r.bodies), M, dM, cos_theta)
+        M = _per_body(r.mass_matrices, dofs, K, 2)
+        dM = _per_body(r.derivatives, dofs, K, 3) if derivatives else None
+        if not batched:
+            M = [m[0] for m in M]
+            dM = None if dM is None else [m[0] for m in dM]
+        return MassMatrices(list(r.bodies), M, dM, cos_theta)
 
     def vertex_jacobians(self, body, q=None, vertices=None):
-        """positions (N, 3) [m, fixed frame] and J (N, 3, 6) = dp/dq of ``body``'s
-        ``vertices`` (None = all) at ``q`` (None = current state, else (6,)).
+        """positions (N, 3) [m, fixed frame] and J (N, 3, d) = dp/dx of ``body``'s
+        ``vertices`` (None = all) at ``q`` (None = current state, else x, (d,)).
 
-        A ``q`` of shape (K, 6) evaluates K configurations in one call:
-        positions (K, N, 3) and J (K, N, 3, 6), each configuration's block the
+        A ``q`` of shape (K, d) evaluates K configurations in one call:
+        positions (K, N, 3) and J (K, N, 3, d), each configuration's block the
         same bits as a call with that q alone. The node's state is not changed."""
-        K = _configurations(q)
+        K = self._configurations(body, q)
         r = self.call('get_vertex_jacobians', body=body, vertices=_indices(vertices), q=_pose(q))
-        return _blocks(r.positions, K, (3,)), _blocks(r.jacobians, K, (3, 6))
+        N = len(r.positions) // (3 * (K or 1))
+        d = len(r.jacobians) // len(r.positions) if len(r.positions) else self.dofs(body)
+        return _blocks(r.positions, K, N), _blocks(r.jacobians, K, N, d)
 
     def vertex_jacobians_compact(self, body, q=None, vertices=None, positions_only=False, single_precision=False):
         """The reduced transport of :meth:`vertex_jacobians`: positions (N, 3) [m]
-        and the rotation blocks Jr (N, 3, 3), ``Jr[v]`` = dp_v/d(phi, theta, psi)
-        (J = [Jr | I3]); Jr is None with ``positions_only``. With
+        and Jr (N, 3, c), the columns of J that are not always I3 (for a free
+        body ``Jr[v]`` = dp_v/d(phi, theta, psi), J = [Jr | I3]; see the module
+        docstring); Jr is None with ``positions_only``. With
         ``single_precision`` both are float32 (the float64 values rounded).
-        A ``q`` of shape (K, 6): (K, N, 3) and (K, N, 3, 3)."""
-        K = _configurations(q)
+        A ``q`` of shape (K, d): (K, N, 3) and (K, N, 3, c)."""
+        K = self._configurations(body, q)
         r = self.call('get_vertex_jacobians_compact', body=body, vertices=_indices(vertices), q=_pose(q),
                       positions_only=bool(positions_only), single_precision=bool(single_precision))
         if single_precision:
             positions, jacobians = r.positions_f32, r.rotation_jacobians_f32
         else:
             positions, jacobians = r.positions, r.rotation_jacobians
-        return _blocks(positions, K, (3,)), None if positions_only else _blocks(jacobians, K, (3, 3))
+        N = len(positions) // (3 * (K or 1))
+        if positions_only:
+            return _blocks(positions, K, N), None
+        c = len(jacobians) // len(positions) if len(positions) else 0
+        return _blocks(positions, K, N), _blocks(jacobians, K, N, c)
 
     def positions(self, body, q=None, vertices=None):
-        """positions (N, 3) [m] only, or (K, N, 3) for a q of shape (K, 6) (the
+        """positions (N, 3) [m] only, or (K, N, 3) for a q of shape (K, d) (the
         same service; J is discarded)."""
         return self.vertex_jacobians(body, q, vertices)[0]
 
     def backprop(self, body, gradients, q=None, vertices=None):
-        """dL/dq (6,) from ``gradients`` = dL/dp, (N, 3), of ``body``'s ``vertices``
+        """dL/dx (d,) from ``gradients`` = dL/dp, (N, 3), of ``body``'s ``vertices``
         (None = all) at ``q`` (None = current state). J is never formed.
 
-        With ``q`` of shape (K, 6) and ``gradients`` of shape (K, N, 3) (the
-        dL/dp of configuration k in ``gradients[k]``): dL/dq of each
-        configuration, (K, 6), each row the same bits as a call with that q
+        With ``q`` of shape (K, d) and ``gradients`` of shape (K, N, 3) (the
+        dL/dp of configuration k in ``gradients[k]``): dL/dx of each
+        configuration, (K, d), each row the same bits as a call with that q
         and gradients alone."""
-        K = _configurations(q)
+        K = self._configurations(body, q)
         r = self.call('backprop', body=body, vertices=_indices(vertices), gradients=_floats(gradients), q=_pose(q))
         gradient = np.asarray(r.gradient)
-        return gradient.reshape(6) if K is None else gradient.reshape(K, 6)
+        return gradient.reshape(-1) if K is None else gradient.reshape(K, -1)

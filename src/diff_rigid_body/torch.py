@@ -1,12 +1,13 @@
 """PyTorch autograd functions over a :class:`~diff_rigid_body.client.RigidBodyClient`.
 
 Shapes follow torch conventions, with a leading batch axis of K
-configurations (q = (phi, theta, psi, tx, ty, tz), float64 tensors on the CPU):
+configurations of the body's coordinates x, d = its dof (float64 tensors on
+the CPU; a free body's x is q = (phi, theta, psi, tx, ty, tz), d = 6):
 
 =======================================  ==========================================
-``vertex_positions(client, body, q)``    q (K, 6) -> p (K, N, 3) [m]; q (6,) -> (N, 3)
-``mass_matrix(client, body, q)``         q (K, 6) -> M (K, 6, 6); q (6,) -> (6, 6)
-``kinetic_energy(client, body, q, qd)``  q, qdot (K, 6) -> E (K,) [J]; (6,) -> ()
+``vertex_positions(client, body, q)``    q (K, d) -> p (K, N, 3) [m]; q (d,) -> (N, 3)
+``mass_matrix(client, body, q)``         q (K, d) -> M (K, d, d); q (d,) -> (d, d)
+``kinetic_energy(client, body, q, qd)``  q, qdot (K, d) -> E (K,) [J]; (d,) -> ()
 =======================================  ==========================================
 
 Each forward pass is one service call for all K configurations
@@ -35,14 +36,14 @@ def _positions(client, body, q, vertices):
 
 
 def positions_batch(client, body, q, vertices=None, per_frame=False):
-    """positions (K, N, 3) of ``body``'s ``vertices`` at the K rows of ``q`` (K, 6)."""
+    """positions (K, N, 3) of ``body``'s ``vertices`` at the K rows of ``q`` (K, d)."""
     if per_frame:
         return np.stack([_positions(client, body, qk, vertices) for qk in q])
     return _positions(client, body, q, vertices)
 
 
 def backprop_batch(client, body, gradients, q, vertices=None, per_frame=False):
-    """dL/dq (K, 6) from dL/dp ``gradients`` (K, N, 3) at ``q`` (K, 6)."""
+    """dL/dq (K, d) from dL/dp ``gradients`` (K, N, 3) at ``q`` (K, d)."""
     if per_frame:
         return np.stack([client.backprop(body, g, qk, vertices) for g, qk in zip(gradients, q)])
     return client.backprop(body, gradients, q, vertices)
@@ -74,7 +75,7 @@ class _MassMatrix(torch.autograd.Function):
             dM = np.stack([a.dM[0] for a in answers])
         else:
             answer = client.mass_matrix([body], q_np[:, None, :], derivatives=True)
-            M, dM = answer.M[:, 0], answer.dM[:, 0]  # (K, 6, 6), (K, 6, 6, 6): dM[k, j] = dM/dq_j
+            M, dM = answer.M[:, 0], answer.dM[:, 0]  # (K, d, d), (K, d, d, d): dM[k, j] = dM/dq_j
         ctx.dM = np.array(dM)
         return torch.from_numpy(np.array(M)).to(q.dtype)
 
@@ -85,33 +86,34 @@ class _MassMatrix(torch.autograd.Function):
         return torch.from_numpy(gradient).to(grad_M.dtype), None, None, None
 
 
-def _batched(q):
-    """(q as (K, 6), whether q was a single (6,) configuration)."""
-    if q.dim() == 1:
-        return q.reshape(1, 6), True
-    if q.dim() != 2 or q.shape[1] != 6:
-        raise ValueError('q must have shape (6,) or (K, 6), not %s' % (tuple(q.shape),))
+def _batched(q, client, body):
+    """(q as (K, d), whether q was a single (d,) configuration); d = ``body``'s dof."""
+    d = client.dofs(body)
+    if q.dim() == 1 and q.shape[0] == d:
+        return q.reshape(1, d), True
+    if q.dim() != 2 or q.shape[1] != d:
+        raise ValueError('q of body %r must have shape (%d,) or (K, %d), not %s' % (body, d, d, tuple(q.shape)))
     return q, False
 
 
 def vertex_positions(client, body, q, vertices=None, per_frame=False):
     """Positions [m] of ``body``'s ``vertices`` (None = all): (K, N, 3) for q
-    (K, 6), (N, 3) for q (6,). Differentiable in q (backward: ``backprop``)."""
-    q2, single = _batched(q)
+    (K, d), (N, 3) for q (d,). Differentiable in q (backward: ``backprop``)."""
+    q2, single = _batched(q, client, body)
     p = _VertexPositions.apply(q2, client, body, vertices, per_frame)
     return p[0] if single else p
 
 
 def mass_matrix(client, body, q, per_frame=False):
-    """M(q) of ``body``: (K, 6, 6) for q (K, 6), (6, 6) for q (6,).
+    """M(q) of ``body``: (K, d, d) for q (K, d), (d, d) for q (d,).
     Differentiable in q (backward from dM/dq of the same call)."""
-    q2, single = _batched(q)
+    q2, single = _batched(q, client, body)
     M = _MassMatrix.apply(q2, client, body, per_frame)
     return M[0] if single else M
 
 
 def kinetic_energy(client, body, q, qdot, per_frame=False):
-    """E = 1/2 qdot^T M(q) qdot [J] per configuration: (K,) for (K, 6), () for (6,).
+    """E = 1/2 qdot^T M(q) qdot [J] per configuration: (K,) for (K, d), () for (d,).
     Differentiable in q and qdot."""
     M = mass_matrix(client, body, q, per_frame)
     return 0.5 * torch.einsum('...a,...ab,...b->...', qdot, M, qdot)

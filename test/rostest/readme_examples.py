@@ -1,8 +1,11 @@
 #!/usr/bin/python3
 """Runs the `rosservice call` examples of README.md against the running node.
 
-Every ```bash block of README.md that contains `rosservice call` is taken;
-its commands run in order, through bash, as a reader would paste them.
+Every ```bash block of README.md that contains `rosservice call` is taken
+(only those of the section under the heading ~section, e.g. "## Robots
+(articulated bodies)", when that parameter is set: each section's examples
+need their own scene); its commands run in order, through bash, as a reader
+would paste them.
 Comment lines right after a command ("# key: value") are the output the
 README promises: each such key must be printed with that value. A command
 without them must print `success: True`.
@@ -45,6 +48,26 @@ def readme_examples(readme_text):
     return examples
 
 
+def markdown_section(text, heading):
+    """The lines from the line ``heading`` to the next heading of the same or a higher level
+    (lines in ``` code blocks are never headings)."""
+    level = len(heading) - len(heading.lstrip('#'))
+    lines, start, in_code = text.splitlines(), None, False
+    for i, line in enumerate(lines):
+        if line.startswith('```'):
+            in_code = not in_code
+            continue
+        if in_code or not line.startswith('#'):
+            continue
+        if start is None and line.strip() == heading:
+            start = i
+        elif start is not None and len(line) - len(line.lstrip('#')) <= level:
+            return '\n'.join(lines[start:i]) + '\n'
+    if start is None:
+        raise ValueError('README.md has no heading %r' % heading)
+    return '\n'.join(lines[start:]) + '\n'
+
+
 def unquote(text):
     text = text.strip()
     if len(text) >= 2 and text[0] == text[-1] and text[0] in '"\'':
@@ -57,9 +80,12 @@ class ReadmeExamples(unittest.TestCase):
     def test_rosservice_examples_work(self):
         readme = os.path.join(rospkg.RosPack().get_path(PKG), 'README.md')
         with open(readme) as f:
-            examples = readme_examples(f.read())
+            text = f.read()
+        section = rospy.get_param('~section', '')
+        examples = readme_examples(markdown_section(text, section) if section else text)
         service_calls = [command for command, _ in examples if command.startswith('rosservice call')]
-        self.assertTrue(service_calls, 'README.md has no ```bash block with `rosservice call`')
+        self.assertTrue(service_calls, 'README.md has no ```bash block with `rosservice call`%s'
+                        % (' in the section %r' % section if section else ''))
         # The node loads its meshes before it serves: wait, as a reader would.
         for service in sorted({command.split()[2] for command in service_calls}):
             rospy.wait_for_service(service, timeout=60.0)

@@ -13,11 +13,19 @@ Private parameters (set them in the .test file):
   ~geometry   collision | visual: the kind the node was told to use (default collision)
   ~server     node name (default /rigid_body_server)
 
+With ~joints: model (the default, interface.md "Version 2") an arm is one
+body holding all its links; with ~joints: free every jointed link is its own
+body. The checks hold in both modes:
+
 Checks: (a) ~get_bodies succeeds; (b) link lists, per-link masses, COMs and
-inertias, and body masses, against the URDF; (c) every mesh vertex and box
-corner of every body's links, placed at the link's tf pose, is within 1e-6 m
-of a served vertex (spheres and cylinders, the node's own tessellation, are
-skipped); (d) conversely for links with only meshes and boxes, and counts.
+inertias, and body masses (the sum of their links'), against the URDF; (c)
+every mesh vertex and box corner of every body's links, placed at the link's
+tf pose, is within 1e-6 m of a served vertex (spheres and cylinders, the
+node's own tessellation, are skipped); (d) conversely for links with only
+meshes and boxes, and counts; (e) each body's coordinates: its joints are
+1-dof, non-mimic URDF joints moving its links, in URDF order, and dofs is
+their number, plus 6 when the body's first link does not hang on one of them
+(a floating root or a free body).
 """
 import os
 import re
@@ -215,7 +223,8 @@ def read_urdf(path):
             'collision': [read_geometry(e, urdf_dir) for e in element.findall('collision')],
             'visual': [read_geometry(e, urdf_dir) for e in element.findall('visual')]}
     joints = [{'name': j.get('name'), 'type': j.get('type'), 'parent': j.find('parent').get('link'),
-               'child': j.find('child').get('link')} for j in robot.findall('joint')]
+               'child': j.find('child').get('link'), 'mimic': j.find('mimic') is not None}
+              for j in robot.findall('joint')]
     return {'name': robot.get('name'), 'links': links, 'joints': joints}
 
 
@@ -395,6 +404,32 @@ class RobotDescription(unittest.TestCase):
                              ' link\'s geometry (max %.6g m)' % (where, (distance > TOLERANCE).sum(), TOLERANCE,
                                                                  distance.max()))
         return distance.max()
+
+    def test_e_coordinates(self):
+        a, per_body = self.bodies()
+        self.assertEqual(len(a.dofs), len(a.names), '%s: dofs is not one per body' % self.robot)
+        self.assertEqual(sum(a.joint_counts), len(a.joint_names), '%s: joint_counts do not add up' % self.robot)
+        order = [j['name'] for j in self.urdf['joints']]
+        joints = {j['name']: j for j in self.urdf['joints']}
+        start = 0
+        for b, indices in enumerate(per_body):
+            names = list(a.joint_names[start:start + a.joint_counts[b]])
+            start += a.joint_counts[b]
+            links = {a.link_names[i] for i in indices}
+            where = '%s: body %s' % (self.robot, a.names[b])
+            for name in names:
+                self.assertIn(name, joints, '%s: joint %s is not in the URDF' % (where, name))
+                j = joints[name]
+                self.assertTrue(j['type'] in ('revolute', 'continuous', 'prismatic') and not j['mimic'],
+                                '%s: joint %s (%s%s) is not an independent 1-dof joint'
+                                % (where, name, j['type'], ', mimic' if j['mimic'] else ''))
+                self.assertIn(j['child'], links, '%s: joint %s moves %s, not one of its links' % (where, name,
+                                                                                                  j['child']))
+            self.assertEqual(names, sorted(names, key=order.index), '%s: joints not in URDF order' % where)
+            root_joint = [n for n, j in joints.items() if j['child'] == a.link_names[indices[0]]]
+            root_floats = not (root_joint and root_joint[0] in names)
+            self.assertEqual(a.dofs[b], len(names) + (6 if root_floats else 0), '%s: dofs %d for joints %s'
+                             % (where, a.dofs[b], names))
 
     def check_counts(self, body, read, served_count, complete):
         """(d) with identical positions joined, the read points are at least as many as the served vertices."""
