@@ -1,10 +1,19 @@
-// A scene of free rigid bodies built from a URDF description (urdfdom).
+// A scene of rigid and articulated bodies built from a URDF description
+// (urdfdom).
 //
-// Semantics (see the package's interface contract):
-//   - A body is the child link of a `floating` joint. The child of a
-//     `revolute`, `continuous`, `prismatic` or `planar` joint is also a free
-//     body (maximal coordinates, initial pose at joint value 0); such joints
-//     are listed in Scene::unmodelled_joints.
+// Semantics (see the package's interface contract, "Version 2"):
+//   - JointHandling::Model (default): a body is a kinematic tree
+//     (articulated_body.h). Its root is the child of a `floating` joint, or a
+//     link joined to a static link by a revolute, continuous or prismatic
+//     joint; the links below it through fixed and 1-dof joints belong to it.
+//     A `floating` joint below a moving link starts a new body; a `planar`
+//     joint makes its child a free body (listed in Scene::unmodelled_joints).
+//     A body with a floating root and no joints is a free body as in
+//     version 1 (SceneBody::articulated is null).
+//   - JointHandling::Free (version 1): the child of every `floating`,
+//     `revolute`, `continuous`, `prismatic` or `planar` joint is a free body
+//     (maximal coordinates, initial pose at joint value 0); the 1-dof and
+//     planar joints are listed in Scene::unmodelled_joints.
 //   - Links joined to a body by `fixed` joints, directly or transitively, are
 //     merged into it: composite mass, COM and inertia, vertices appended.
 //   - Links fixed to the root are static: no state, published once.
@@ -15,12 +24,14 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include <Eigen/Geometry>
 
+#include "diff_rigid_body/articulated_body.h"
 #include "diff_rigid_body/rigid_body.h"
 
 namespace diff_rigid_body
@@ -33,8 +44,16 @@ enum class GeometrySource
   Visual
 };
 
+/// How 1-dof joints are treated (~joints).
+enum class JointHandling
+{
+  Model,  ///< bodies are kinematic trees with joint coordinates
+  Free    ///< version 1: every moving link is a free body
+};
+
 struct SceneOptions
 {
+  JointHandling joints = JointHandling::Model;
   GeometrySource geometry = GeometrySource::Collision;
   /// [kg/m^3] When set, a link without <inertial> gets its mass properties
   /// from its closed geometry. When unset, such a link is merged as massless
@@ -59,11 +78,14 @@ struct SceneOptions
   std::string base_directory;
 };
 
-/// A link merged into a body, with its fixed pose relative to the body's link frame.
+/// A link of a body, with its fixed pose relative to the body's link frame
+/// (for an articulated body: relative to its segment's link frame).
 struct LinkInBody
 {
   std::string name;
   Eigen::Isometry3d pose_in_body_link = Eigen::Isometry3d::Identity();
+  /// Index of its segment in SceneBody::articulated (0 for a free body).
+  std::size_t segment = 0;
   /// Indices (into RigidBody::vertices) of this link's own geometry vertices,
   /// in the link's geometry order.
   std::vector<std::uint32_t> vertex_indices;
@@ -77,14 +99,31 @@ struct LinkInBody
 
 struct SceneBody
 {
+  /// A free body's model. For an articulated body: its name, total mass,
+  /// the root segment's inertia and COM offset, and no vertices (they are
+  /// in `articulated`).
   RigidBody body;
-  /// q = (phi, theta, psi, tx, ty, tz) from the URDF joint origins.
-  Vector6<double> initial_state = Vector6<double>::Zero();
-  /// The body's own link first, then its merged links in document order.
+  /// The kinematic tree of a body with joints; null for a free body.
+  std::shared_ptr<const ArticulatedBody> articulated;
+  /// x at load: q = (phi, theta, psi, tx, ty, tz) from the URDF joint origins
+  /// for a free body or floating root, then every joint at 0.
+  Eigen::VectorXd initial_state = Eigen::VectorXd::Zero(6);
+  /// Free body: the body's own link first, then its merged links in document
+  /// order. Articulated body: segment after segment, each its link first,
+  /// then its merged links; vertex ranges follow the same order.
   std::vector<LinkInBody> links;
   /// Name of the joint that made this link a body, and its URDF type.
   std::string joint_name;
   std::string joint_type;
+
+  /// len(x): 6 for a free body.
+  std::size_t dofs() const { return articulated ? articulated->dofs() : 6; }
+  /// Number of vertices.
+  std::size_t vertexCount() const
+  {
+    return articulated ? static_cast<std::size_t>(articulated->vertices.cols()) :
+                         static_cast<std::size_t>(body.vertices.cols());
+  }
 };
 
 /// A link fixed to the root, with its pose in the fixed frame.

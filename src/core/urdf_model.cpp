@@ -45,7 +45,7 @@ urdf::ModelInterfaceSharedPtr parseUrdfModel(const std::string& urdf_xml)
   return model;
 }
 
-std::vector<std::string> linkNamesInDocumentOrder(const std::string& urdf_xml)
+std::vector<std::string> namesInDocumentOrder(const std::string& urdf_xml, const char* element)
 {
   tinyxml2::XMLDocument document;
   if (document.Parse(urdf_xml.c_str(), urdf_xml.size()) != tinyxml2::XML_SUCCESS)
@@ -58,10 +58,10 @@ std::vector<std::string> linkNamesInDocumentOrder(const std::string& urdf_xml)
   if (!robot)
     throw SceneDescriptionError("robot description: no <robot> element");
   std::vector<std::string> names;
-  for (const tinyxml2::XMLElement* link = robot->FirstChildElement("link"); link;
-       link = link->NextSiblingElement("link"))
+  for (const tinyxml2::XMLElement* child = robot->FirstChildElement(element); child;
+       child = child->NextSiblingElement(element))
   {
-    const char* name = link->Attribute("name");
+    const char* name = child->Attribute("name");
     if (name)
       names.emplace_back(name);
   }

@@ -20,9 +20,10 @@ namespace detail
 /// refuses the description.
 urdf::ModelInterfaceSharedPtr parseUrdfModel(const std::string& urdf_xml);
 
-/// Link names in document order (urdfdom keeps them in a std::map). Throws
-/// SceneDescriptionError for malformed XML or a missing <robot>.
-std::vector<std::string> linkNamesInDocumentOrder(const std::string& urdf_xml);
+/// Names of the <robot>'s `element` children ("link" or "joint") in document
+/// order (urdfdom keeps them in std::maps). Throws SceneDescriptionError for
+/// malformed XML or a missing <robot>.
+std::vector<std::string> namesInDocumentOrder(const std::string& urdf_xml, const char* element);
 
 /// The pose as an isometry (quaternion normalised).
 Eigen::Isometry3d toIsometry(const urdf::Pose& pose);

@@ -79,7 +79,7 @@ TEST(UrdfScene, MergesFixedLinksTransitivelyWithParallelAxisInertia)
   EXPECT_TRUE(scene.unmodelled_joints.empty());
 }
 
-TEST(UrdfScene, StaticLinksAndUnmodelledJoints)
+TEST(UrdfScene, StaticLinksAndUnmodelledJointsWhenJointsAreFree)
 {
   const std::string xml =
       robot(link("table", collision(boxGeometry("1 1 1"))) + link("box", inertial()) + link("flap", inertial()) +
@@ -88,7 +88,9 @@ TEST(UrdfScene, StaticLinksAndUnmodelledJoints)
             "<joint name=\"hinge\" type=\"revolute\"><parent link=\"box\"/><child link=\"flap\"/>"
             "<origin xyz=\"0 0 0.25\"/><axis xyz=\"1 0 0\"/>"
             "<limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1\"/></joint>");
-  const drb::Scene scene = drb::loadSceneFromUrdf(xml);
+  drb::SceneOptions free_joints;
+  free_joints.joints = drb::JointHandling::Free;
+  const drb::Scene scene = drb::loadSceneFromUrdf(xml, free_joints);
   ASSERT_EQ(scene.static_links.size(), 1u);
   EXPECT_EQ(scene.static_links[0].name, "table");
   EXPECT_TRUE(scene.static_links[0].pose_in_fixed_frame.translation().isApprox(Eigen::Vector3d(0, 0, 0.5)));
@@ -101,7 +103,7 @@ TEST(UrdfScene, StaticLinksAndUnmodelledJoints)
   EXPECT_NE(scene.unmodelled_joints[0].find("hinge"), std::string::npos);
 
   // States can be expressed in a static link instead of the root.
-  drb::SceneOptions in_table;
+  drb::SceneOptions in_table = free_joints;
   in_table.fixed_frame = "table";
   const drb::Scene relative = drb::loadSceneFromUrdf(xml, in_table);
   EXPECT_NEAR(relative.bodies[0].initial_state[drb::TZ], 1.0, kLengthTolerance);
@@ -110,7 +112,7 @@ TEST(UrdfScene, StaticLinksAndUnmodelledJoints)
   EXPECT_NEAR(relative.static_links[0].pose_in_fixed_frame.translation().z(), -0.5, kLengthTolerance);
 
   // Only the listed bodies are modelled.
-  drb::SceneOptions only_flap;
+  drb::SceneOptions only_flap = free_joints;
   only_flap.bodies = { "flap" };
   const drb::Scene subset = drb::loadSceneFromUrdf(xml, only_flap);
   ASSERT_EQ(subset.bodies.size(), 1u);

@@ -1,0 +1,212 @@
+// Loading kinematic trees (~joints: model, interface.md "Version 2"): which
+// links form a body, its coordinates and limits, mimic joints, vertex ranges,
+// warnings; and the textbook two-link arm's M(x) as a closed-form oracle.
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "diff_rigid_body/articulated_kinematics.h"
+#include "diff_rigid_body/exceptions.h"
+#include "diff_rigid_body/urdf_scene.h"
+#include "../support/expect_throws.h"
+#include "../support/urdf_builders.h"
+
+namespace drb = diff_rigid_body;
+using namespace drb_test::urdf;
+
+namespace
+{
+/// A 1-dof joint named `name` with an axis and limits.
+std::string oneDofJoint(const std::string& name, const std::string& type, const std::string& parent,
+                        const std::string& child, const std::string& origin, const std::string& axis,
+                        const std::string& extra = "")
+{
+  return "<joint name=\"" + name + "\" type=\"" + type + "\"><parent link=\"" + parent + "\"/><child link=\"" +
+         child + "\"/>" + origin + "<axis xyz=\"" + axis + "\"/>" +
+         (type == "continuous" ? "" : "<limit lower=\"-1.5\" upper=\"2\" effort=\"1\" velocity=\"1\"/>") + extra +
+         "</joint>";
+}
+
+/// A point-like link: mass m at (lc, 0, 0) with inertia izz about its COM.
+std::string rodLink(const std::string& name, double m, double lc, double izz)
+{
+  return link(name, "<inertial><origin xyz=\"" + std::to_string(lc) + " 0 0\"/><mass value=\"" +
+                        std::to_string(m) + "\"/><inertia ixx=\"" + std::to_string(izz) +
+                        "\" ixy=\"0\" ixz=\"0\" iyy=\"" + std::to_string(izz) + "\" iyz=\"0\" izz=\"" +
+                        std::to_string(izz) + "\"/></inertial>" + collision(boxGeometry("0.1 0.1 0.1")));
+}
+}  // namespace
+
+// Two links in a horizontal plane, joints about z: the closed form of any
+// robotics textbook, M11 = I1 + I2 + m1 c1^2 + m2 (l1^2 + c2^2 + 2 l1 c2 cos x2),
+// M12 = I2 + m2 (c2^2 + l1 c2 cos x2), M22 = I2 + m2 c2^2.
+TEST(ArticulatedScene, TwoLinkArmMatchesTheClosedForm)
+{
+  const double m1 = 1.5, c1 = 0.25, I1 = 0.02, l1 = 0.6, m2 = 0.75, c2 = 0.375, I2 = 0.01;
+  const std::string xml = robot(rodLink("upper", m1, c1, I1) + rodLink("fore", m2, c2, I2) +
+                                oneDofJoint("shoulder", "continuous", "world", "upper", "", "0 0 1") +
+                                oneDofJoint("elbow", "revolute", "upper", "fore",
+                                            "<origin xyz=\"" + std::to_string(l1) + " 0 0\"/>", "0 0 1"));
+  const drb::Scene scene = drb::loadSceneFromUrdf(xml);
+  ASSERT_EQ(scene.bodies.size(), 1u);
+  ASSERT_TRUE(scene.bodies[0].articulated);
+  const drb::ArticulatedBody& arm = *scene.bodies[0].articulated;
+  ASSERT_EQ(arm.dofs(), 2u);
+  for (const double x2 : { 0.0, 0.7, -1.4, 2.0 })
+  {
+    const double x[2] = { 0.3, x2 };
+    const Eigen::MatrixXd M = drb::articulatedMassMatrix(arm, x);
+    const double M11 = I1 + I2 + m1 * c1 * c1 + m2 * (l1 * l1 + c2 * c2 + 2 * l1 * c2 * std::cos(x2));
+    const double M12 = I2 + m2 * (c2 * c2 + l1 * c2 * std::cos(x2));
+    const double M22 = I2 + m2 * c2 * c2;
+    EXPECT_NEAR(M(0, 0), M11, 1e-15) << "x2 = " << x2;
+    EXPECT_NEAR(M(0, 1), M12, 1e-15) << "x2 = " << x2;
+    EXPECT_NEAR(M(1, 0), M12, 1e-15) << "x2 = " << x2;
+    EXPECT_NEAR(M(1, 1), M22, 1e-15) << "x2 = " << x2;
+  }
+}
+
+TEST(ArticulatedScene, FixedBaseTreeHasItsJointsInDocumentOrderWithLimits)
+{
+  // Document order of joints (b_joint before a_joint) differs from the tree and name order.
+  const std::string xml =
+      robot(rodLink("base", 1, 0, 0.1) + rodLink("a", 1, 0.1, 0.1) + rodLink("b", 1, 0.1, 0.1) +
+            link("tool", inertial("0.5") + collision(boxGeometry("0.1 0.1 0.1"))) +
+            oneDofJoint("b_joint", "prismatic", "base", "b", "<origin xyz=\"0 1 0\"/>", "0 0 2") +
+            oneDofJoint("base_joint", "continuous", "world", "base", "<origin xyz=\"0 0 1\"/>", "0 0 1") +
+            oneDofJoint("a_joint", "revolute", "base", "a", "<origin xyz=\"1 0 0\"/>", "0 1 0") +
+            joint("fixed", "a", "tool", "<origin xyz=\"0.5 0 0\"/>"));
+  const drb::Scene scene = drb::loadSceneFromUrdf(xml);
+  ASSERT_EQ(scene.bodies.size(), 1u);
+  const drb::SceneBody& body = scene.bodies[0];
+  ASSERT_TRUE(body.articulated);
+  const drb::ArticulatedBody& tree = *body.articulated;
+  EXPECT_EQ(body.body.name, "base");
+  EXPECT_FALSE(tree.floating_root);
+  EXPECT_EQ(tree.joint_names, (std::vector<std::string>{ "b_joint", "base_joint", "a_joint" }));
+  EXPECT_EQ(tree.joint_lower, (std::vector<double>{ -1.5, -std::numeric_limits<double>::infinity(), -1.5 }));
+  EXPECT_EQ(tree.joint_upper, (std::vector<double>{ 2, std::numeric_limits<double>::infinity(), 2 }));
+  EXPECT_EQ(body.initial_state, Eigen::VectorXd::Zero(3));
+  EXPECT_DOUBLE_EQ(body.body.mass, 3.5);
+  // Segments: parents first, then children in link document order (a before b).
+  ASSERT_EQ(tree.segments.size(), 3u);
+  EXPECT_EQ(tree.segments[0].link, "base");
+  EXPECT_EQ(tree.segments[1].link, "a");
+  EXPECT_EQ(tree.segments[2].link, "b");
+  EXPECT_EQ(tree.segments[1].coordinate, 2);
+  EXPECT_EQ(tree.segments[2].coordinate, 0);
+  EXPECT_EQ(tree.segments[2].motion, drb::JointMotion::Prismatic);
+  EXPECT_TRUE(tree.segments[2].axis.isApprox(Eigen::Vector3d::UnitZ())) << "the axis is normalised";
+  // The tool is merged into segment a, whose mass it adds to.
+  ASSERT_EQ(body.links.size(), 4u);
+  EXPECT_EQ(body.links[2].name, "tool");
+  EXPECT_EQ(body.links[2].segment, 1u);
+  EXPECT_DOUBLE_EQ(tree.segments[1].mass_properties.mass, 1.5);
+  // Each segment's box corners are contiguous, in segment order (a has the tool's too).
+  EXPECT_EQ(tree.segments[1].vertex_begin, 8u);
+  EXPECT_EQ(tree.segments[1].vertex_count, 16u);
+  EXPECT_EQ(tree.segments[2].vertex_begin, 24u);
+  EXPECT_EQ(tree.segmentOfVertex(7), 0u);
+  EXPECT_EQ(tree.segmentOfVertex(8), 1u);
+  EXPECT_EQ(tree.segmentOfVertex(23), 1u);
+  EXPECT_EQ(tree.segmentOfVertex(24), 2u);
+
+  // Joint values move the links: b slides 2 along z, a turns about y at (1, 0, 1).
+  const double x[3] = { 0.25, 0.0, M_PI / 2 };
+  const drb::ArticulatedPose<double> pose = drb::articulatedPose(tree, x);
+  EXPECT_TRUE(pose.frames[2].p.isApprox(Eigen::Vector3d(0, 1, 1.25), 1e-15));
+  const Eigen::Vector3d tool_tip = pose.frames[1].R * Eigen::Vector3d(0.5, 0, 0) + pose.frames[1].p;
+  EXPECT_NEAR((tool_tip - Eigen::Vector3d(1, 0, 0.5)).norm(), 0.0, 1e-15);
+}
+
+TEST(ArticulatedScene, MimicJointFollowsItsMasterAndAddsNoCoordinate)
+{
+  const std::string xml = robot(
+      rodLink("palm", 1, 0, 0.1) + rodLink("left", 0.1, 0, 0.01) + rodLink("right", 0.1, 0, 0.01) +
+      oneDofJoint("palm_joint", "revolute", "world", "palm", "", "0 0 1") +
+      oneDofJoint("left_joint", "prismatic", "palm", "left", "", "0 1 0") +
+      oneDofJoint("right_joint", "prismatic", "palm", "right", "", "0 -1 0",
+                  "<mimic joint=\"left_joint\" multiplier=\"2\" offset=\"0.01\"/>"));
+  const drb::Scene scene = drb::loadSceneFromUrdf(xml);
+  const drb::ArticulatedBody& hand = *scene.bodies.at(0).articulated;
+  EXPECT_EQ(hand.joint_names, (std::vector<std::string>{ "palm_joint", "left_joint" }));
+  ASSERT_EQ(hand.segments.size(), 3u);
+  EXPECT_EQ(hand.segments[2].coordinate, 1);
+  EXPECT_EQ(hand.segments[2].multiplier, 2.0);
+  EXPECT_EQ(hand.segments[2].offset, 0.01);
+  const double x[2] = { 0.0, 0.02 };
+  const drb::ArticulatedPose<double> pose = drb::articulatedPose(hand, x);
+  EXPECT_NEAR(pose.frames[2].p.y(), -(2 * 0.02 + 0.01), 1e-17);
+}
+
+TEST(ArticulatedScene, FloatingRootCarriesItsJointsAndAFloatingJointBelowStartsANewBody)
+{
+  const std::string xml =
+      robot(rodLink("torso", 5, 0.1, 0.2) + rodLink("leg", 1, 0, 0.05) + rodLink("ball", 0.2, 0, 0.01) +
+            floatingJoint("torso", "<origin xyz=\"0 0 1\" rpy=\"0.1 0.2 0.3\"/>") +
+            oneDofJoint("hip", "revolute", "torso", "leg", "<origin xyz=\"0 0 -0.2\"/>", "0 1 0") +
+            floatingJoint("ball", "", "leg"));
+  const drb::Scene scene = drb::loadSceneFromUrdf(xml);
+  ASSERT_EQ(scene.bodies.size(), 2u);
+  const drb::SceneBody& torso = scene.bodies[0];
+  ASSERT_TRUE(torso.articulated);
+  EXPECT_TRUE(torso.articulated->floating_root);
+  EXPECT_EQ(torso.dofs(), 7u);
+  EXPECT_NEAR(torso.initial_state[0], 0.1, 1e-15);
+  EXPECT_NEAR(torso.initial_state[1], 0.2, 1e-15);
+  EXPECT_NEAR(torso.initial_state[2], 0.3, 1e-15);
+  EXPECT_EQ(torso.initial_state[6], 0.0);
+  EXPECT_EQ(scene.bodies[1].body.name, "ball");
+  EXPECT_FALSE(scene.bodies[1].articulated) << "a floating body without joints is a version-1 free body";
+}
+
+TEST(ArticulatedScene, PlanarJointMakesAFreeBodyWithANote)
+{
+  const std::string xml = robot(rodLink("puck", 1, 0, 0.1) + oneDofJoint("slide", "planar", "world", "puck", "", "0 0 1"));
+  const drb::Scene scene = drb::loadSceneFromUrdf(xml);
+  ASSERT_EQ(scene.bodies.size(), 1u);
+  EXPECT_FALSE(scene.bodies[0].articulated);
+  ASSERT_EQ(scene.unmodelled_joints.size(), 1u);
+  EXPECT_NE(scene.unmodelled_joints[0].find("'slide' (planar)"), std::string::npos) << scene.unmodelled_joints[0];
+}
+
+TEST(ArticulatedScene, FreeObjectsLoadAsInVersionOne)
+{
+  const std::string xml = twoBodies();
+  drb::SceneOptions free_joints;
+  free_joints.joints = drb::JointHandling::Free;
+  const drb::Scene model = drb::loadSceneFromUrdf(xml);
+  const drb::Scene v1 = drb::loadSceneFromUrdf(xml, free_joints);
+  ASSERT_EQ(model.bodies.size(), v1.bodies.size());
+  for (std::size_t i = 0; i < v1.bodies.size(); ++i)
+  {
+    EXPECT_FALSE(model.bodies[i].articulated);
+    EXPECT_EQ(model.bodies[i].initial_state, v1.bodies[i].initial_state);
+    EXPECT_EQ(model.bodies[i].body.vertices, v1.bodies[i].body.vertices);
+    EXPECT_EQ(model.bodies[i].body.inertia_body, v1.bodies[i].body.inertia_body);
+    EXPECT_EQ(model.bodies[i].body.com_offset, v1.bodies[i].body.com_offset);
+  }
+}
+
+TEST(ArticulatedScene, ZeroAxisIsRefusedNamingTheJoint)
+{
+  const std::string xml = robot(rodLink("arm", 1, 0, 0.1) + oneDofJoint("bad", "revolute", "world", "arm", "", "0 0 0"));
+  DRB_EXPECT_THROWS_MESSAGE(drb::loadSceneFromUrdf(xml), drb::SceneDescriptionError, "joint 'bad': <axis>");
+}
+
+TEST(ArticulatedScene, CoordinateThatMovesNoMassWarnsAndStrictRefuses)
+{
+  const std::string xml = robot(rodLink("arm", 1, 0, 0.1) + link("tip", collision(boxGeometry("0.1 0.1 0.1"))) +
+                                oneDofJoint("arm_joint", "revolute", "world", "arm", "", "0 0 1") +
+                                oneDofJoint("tip_joint", "revolute", "arm", "tip", "", "1 0 0"));
+  const drb::Scene scene = drb::loadSceneFromUrdf(xml);
+  bool warned = false;
+  for (const std::string& warning : scene.warnings)
+    warned |= warning.find("joint 'tip_joint' of body 'arm': moves no mass") != std::string::npos;
+  EXPECT_TRUE(warned);
+  drb::SceneOptions strict;
+  strict.strict_inertia = true;
+  DRB_EXPECT_THROWS_MESSAGE(drb::loadSceneFromUrdf(xml, strict), drb::InvalidInertiaError, "link 'tip': no <inertial>");
+}
