@@ -75,6 +75,26 @@ std::vector<SegmentMotion> segmentMotions(const ArticulatedBody& body, const Art
   return motions;
 }
 
+/// G = sum g_i and W = sum g_i p_i^T over `count` vertices (g, p: 3 x count,
+/// column-major), in blocks of 4 columns with two accumulators so that the
+/// products are unrolled and vectorised.
+void gradientMoments(const double* gradients, const double* points, Eigen::Index count, Eigen::Vector3d& G,
+                     Eigen::Matrix3d& W)
+{
+  const Eigen::Map<const Eigen::Matrix3Xd> g(gradients, 3, count), p(points, 3, count);
+  Eigen::Matrix3d W0 = Eigen::Matrix3d::Zero(), W1 = Eigen::Matrix3d::Zero();
+  Eigen::Index i = 0;
+  for (; i + 8 <= count; i += 8)
+  {
+    W0.noalias() += g.middleCols<4>(i) * p.middleCols<4>(i).transpose();
+    W1.noalias() += g.middleCols<4>(i + 4) * p.middleCols<4>(i + 4).transpose();
+  }
+  for (; i < count; ++i)
+    W0.noalias() += g.col(i) * p.col(i).transpose();
+  W = W0 + W1;
+  G = g.rowwise().sum();
+}
+
 /// Calls visit(vertex slot k, vertex index v, segment s) for the selected vertices.
 template <typename Visit>
 void forEachVertex(const ArticulatedBody& body, const std::vector<std::uint32_t>& vertices, Visit visit)
@@ -130,7 +150,7 @@ void articulatedBackprop(const ArticulatedBody& body, const ArticulatedPose<doub
 {
   // Per segment: G = sum g and H = sum (p - r) x g, and dL/dx = sum_s V_s^T G_s + W_s^T H_s.
   // With p - r = R p0 + (p_s - r) and W = sum g p0^T (for a whole segment one
-  // 3 x N by N x 3 product), A = sum g (R p0)^T = W R^T gives
+  // pass over its vertices), A = sum g (R p0)^T = W R^T gives
   // sum (R p0) x g = (A_zy - A_yz, A_xz - A_zx, A_yx - A_xy).
   const std::size_t n = body.segments.size();
   std::vector<Eigen::Vector3d> G(n, Eigen::Vector3d::Zero());
@@ -139,10 +159,8 @@ void articulatedBackprop(const ArticulatedBody& body, const ArticulatedPose<doub
     for (std::size_t s = 0; s < n; ++s)
     {
       const Segment& segment = body.segments[s];
-      const Eigen::Map<const Eigen::Matrix3Xd> g(gradients + 3 * std::size_t(segment.vertex_begin), 3,
-                                                 segment.vertex_count);
-      G[s] = g.rowwise().sum();
-      outer[s].noalias() = g * body.vertices.middleCols(segment.vertex_begin, segment.vertex_count).transpose();
+      gradientMoments(gradients + 3 * std::size_t(segment.vertex_begin), body.vertices.col(segment.vertex_begin).data(),
+                      segment.vertex_count, G[s], outer[s]);
     }
   else
     for (std::size_t k = 0; k < vertices.size(); ++k)
