@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "diff_rigid_body/articulated_kinematics.h"
+#include "diff_rigid_body/articulated_queries.h"
 #include "diff_rigid_body/exceptions.h"
 #include "diff_rigid_body/urdf_scene.h"
 #include "../support/expect_throws.h"
@@ -209,4 +209,49 @@ TEST(ArticulatedScene, CoordinateThatMovesNoMassWarnsAndStrictRefuses)
   drb::SceneOptions strict;
   strict.strict_inertia = true;
   DRB_EXPECT_THROWS_MESSAGE(drb::loadSceneFromUrdf(xml, strict), drb::InvalidInertiaError, "link 'tip': no <inertial>");
+}
+
+// The all-vertex paths (blocked moments, segment by segment) against the
+// index-list paths (vertex by vertex), and backprop against J^T g.
+TEST(ArticulatedScene, AllVertexPathsAgreeWithIndexListsAndJTransposeG)
+{
+  const std::string xml =
+      robot(rodLink("torso", 5, 0.1, 0.2) + rodLink("leg", 1, 0, 0.05) + rodLink("foot", 0.5, 0.05, 0.01) +
+            floatingJoint("torso", "<origin xyz=\"0 0 1\"/>") +
+            oneDofJoint("hip", "revolute", "torso", "leg", "<origin xyz=\"0 0 -0.2\"/>", "0 1 0") +
+            oneDofJoint("ankle", "prismatic", "leg", "foot", "<origin xyz=\"0 0 -0.4\"/>", "1 0 1"));
+  const drb::Scene scene = drb::loadSceneFromUrdf(xml);
+  const drb::ArticulatedBody& body = *scene.bodies.at(0).articulated;
+  const std::size_t n = static_cast<std::size_t>(body.vertices.cols()), dofs = body.dofs();
+  ASSERT_EQ(dofs, 8u);
+  const double x[8] = { 0.3, -0.4, 1.1, 0.5, -0.2, 0.9, 0.7, 0.05 };
+  const drb::ArticulatedPose<double> pose = drb::articulatedPose(body, x);
+  std::vector<std::uint32_t> every(n);
+  std::vector<double> g(3 * n);
+  for (std::size_t v = 0; v < n; ++v)
+  {
+    every[v] = static_cast<std::uint32_t>(v);
+    for (int i = 0; i < 3; ++i)
+      g[3 * v + i] = std::sin(1.0 + 3.0 * v + i);
+  }
+  std::vector<double> p_all(3 * n), J_all(3 * dofs * n), p_list(3 * n), J_list(3 * dofs * n);
+  drb::articulatedVertexJacobians(body, pose, {}, {}, p_all.data(), J_all.data());
+  drb::articulatedVertexJacobians(body, pose, every, {}, p_list.data(), J_list.data());
+  EXPECT_EQ(p_all, p_list);
+  EXPECT_EQ(J_all, J_list);
+  std::vector<double> grad_all(dofs), grad_list(dofs);
+  drb::articulatedBackprop(body, pose, {}, g.data(), grad_all.data());
+  drb::articulatedBackprop(body, pose, every, g.data(), grad_list.data());
+  for (std::size_t c = 0; c < dofs; ++c)
+  {
+    double jtg = 0.0, scale = 0.0;
+    for (std::size_t v = 0; v < n; ++v)
+      for (std::size_t i = 0; i < 3; ++i)
+      {
+        jtg += J_all[3 * dofs * v + dofs * i + c] * g[3 * v + i];
+        scale += std::abs(J_all[3 * dofs * v + dofs * i + c] * g[3 * v + i]);
+      }
+    EXPECT_NEAR(grad_all[c], jtg, 1e-14 * scale) << "coordinate " << c;
+    EXPECT_NEAR(grad_list[c], jtg, 1e-14 * scale) << "coordinate " << c;
+  }
 }
