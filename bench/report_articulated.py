@@ -114,7 +114,7 @@ def vertex_rows(k, c, targets):
             row("backprop, pose made outside the loop (kernel alone)", NOT_NODE, kernel, rfloor),
             row("backprop through the 12 sums per segment (`detail::gradientSums` on each segment's vertices "
                 "by coordinate, bench/articulated_prototypes.h; pose included)"
-                + (f"; max |Δ| / max |dL/dx| against `articulatedBackprop` {fmt_err(agree)}" if agree is not None
+                + (f"; ‖Δ‖∞ / ‖dL/dx‖∞ against `articulatedBackprop` {fmt_err(agree)}" if agree is not None
                    else ""), NOT_NODE, sums, rfloor),
             row(f"read floor, `{rname}`: gradients and vertices read once (48 B per vertex)", FLOOR, rfloor, rfloor)]
     if bp and rfloor:
