@@ -6,12 +6,12 @@ that serves a robot with ~joints: model (e.g. the Panda).
 
 A hidden configuration x* within the joint limits is drawn; the vertices
 of the arm's last links at x* (plus noise) are the observations; the fit
-starts from the node's current state (the URDF zero pose, or whatever
-joint_states set) and uses SciPy's least_squares with the node's
+starts from x = 0 clipped into the limits (or, with --start state, from the
+node's current state, e.g. what joint_states set) and uses SciPy's least_squares with the node's
 dp/dx as the Jacobian and the joint limits as bounds. The result is set as
 the node's state, so tf and rviz show the fitted arm.
 
-Usage: joint_fit_client.py [--server /arm/rigid_body_server] [--noise 0.0]
+Usage: joint_fit_client.py [--server /arm/rigid_body_server] [--noise 0.0] [--start zero|state]
 
 Exits 1 unless the fit converges: without noise to EXACT [rad or m] of x*;
 with noise to NOISE_SIGMAS standard deviations of the estimate. On success
@@ -50,6 +50,8 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--server', default='rigid_body_server')
     parser.add_argument('--noise', type=float, default=0.0, help='[m] standard deviation of the observations')
+    parser.add_argument('--start', choices=('zero', 'state'), default='zero',
+                        help='start from x = 0 (clipped into the limits) or from the node\'s current state')
     args = parser.parse_args(rospy.myargv()[1:])
     rospy.init_node('joint_fit_client', anonymous=True, disable_signals=True)
     rng = np.random.default_rng(SEED)
@@ -59,7 +61,7 @@ def main():
         x_hidden = hidden_configuration(lower, upper, rng)
         observed = client.positions(body, q=x_hidden)
         observed = observed + args.noise * rng.standard_normal(observed.shape)
-        x0 = client.get_state([body])[body]
+        x0 = client.get_state([body])[body] if args.start == 'state' else np.zeros(dofs)
         x, result, calls = fit_joints(client, body, observed, x0)
         error = np.abs(x - x_hidden).max()
         print('joint fit of %s (%d coordinates, %d vertices): %d round trips, |x - x*|_inf = %.3g, cost %.3g'

@@ -33,8 +33,8 @@ DRB_APT_PACKAGES=(
   python3-numpy python3-yaml python3-scipy
   # diff_rigid_body.torch, its rostest, the trajectory demo and bench/client_trajectory.py
   python3-torch
-  # joint_states (sensor_msgs/JointState)
-  ros-sensor-msgs python3-sensor-msgs libsensor-msgs-dev
+  # joint_states (sensor_msgs/JointState); demo.launch joint_state_publisher:=true|gui
+  ros-sensor-msgs python3-sensor-msgs libsensor-msgs-dev joint-state-publisher joint-state-publisher-gui
   python3-matplotlib
   # clients and rviz: the Python client, rviz, and the headless screenshot
   # (xvfb-run needs xauth; software OpenGL comes from the Mesa DRI drivers)
