@@ -6,7 +6,9 @@ frame) at the q of each ``~states`` message, so in rviz they must sit on the
 meshes that RobotModel draws from tf: a visual check that tf and the
 services agree. Optionally the Jacobian column dp/dq_j of one coordinate is
 drawn as arrows (line segments from each vertex along dp/dq_j) at a subset
-of the vertices.
+of the vertices. With ``~color_by: link`` every link of a body (get_bodies'
+links: a body's vertices are its links', contiguous, in link order) has its
+own colour, so the links of an articulated body are told apart.
 
 Subscribes: ``<server>/states`` (diff_rigid_body/BodyStateArray)
 Publishes:  ``~markers`` (visualization_msgs/MarkerArray, latched), only when
@@ -16,12 +18,15 @@ Parameters:
   ~server          the node to ask (default: rigid_body_server)
   ~point_size      [m] point marker width (default 0.0025)
   ~stride          draw every stride-th vertex (default 1: all)
-  ~jacobian_column -1 (default): no arrows; 0..5: arrows of dp/dq_j
+  ~jacobian_column -1 (default): no arrows; j >= 0: arrows of dp/dq_j, for the
+                   bodies with more than j coordinates (d: 6 for a free body)
   ~arrow_stride    arrow every arrow_stride-th vertex (default 32)
   ~arrow_length    [m] length of a body's longest arrow (default 0.04); the
                    others in proportion to |dp/dq_j|
   ~max_rate        [Hz] (default 10)
-  ~colors          {body: [r, g, b]} point colours (defaults: a fixed palette)
+  ~color_by        'body' (default): one colour per body; 'link': one per link
+  ~colors          {name: [r, g, b]} point colours, names of bodies or of links
+                   as ~color_by says (unlisted names: a fixed palette, in order)
 """
 import colorsys
 import threading
@@ -56,15 +61,19 @@ class VertexMarkers(object):
         self.arrow_length = float(rospy.get_param('~arrow_length', 0.04))
         self.min_period = rospy.Duration(1.0 / max(float(rospy.get_param('~max_rate', 10.0)), 0.1))
         colors = rospy.get_param('~colors', {})
-        if not -1 <= self.column <= 5:
-            raise ValueError('~jacobian_column must be -1 (none) or 0..5, not %d' % self.column)
+        color_by = rospy.get_param('~color_by', 'body')
+        if self.column < -1:
+            raise ValueError('~jacobian_column must be -1 (none) or a coordinate index >= 0, not %d' % self.column)
+        if color_by not in ('body', 'link'):
+            raise ValueError("~color_by must be 'body' or 'link', not %r" % color_by)
 
         bodies = self.client.bodies()
         self.fixed_frame = bodies.fixed_frame
         self.names = bodies.names
-        self.colors = {name: colors.get(name, PALETTE[i % len(PALETTE)]) for i, name in enumerate(self.names)}
+        self.dofs = dict(zip(self.names, (int(d) for d in bodies.dofs)))
         self.vertices = {name: np.arange(0, count, self.stride)
                          for name, count in zip(self.names, bodies.vertex_counts)}
+        self.groups = self.colour_groups(bodies, color_by, colors)
 
         self.lock = threading.Lock()
         self.last_q = None
@@ -74,6 +83,25 @@ class VertexMarkers(object):
         self.subscriber = rospy.Subscriber(rospy.resolve_name(server) + '/states', BodyStateArray, self.on_states,
                                            queue_size=1)
         self.timer = rospy.Timer(self.min_period, self.on_timer)
+
+    def colour_groups(self, bodies, color_by, colors):
+        """Per body: [(name, colour, rows)], the rows of ``self.vertices[body]``
+        drawn in that colour: all of them (by body) or each link's (by link;
+        links without vertices have none)."""
+        groups, used = {}, 0
+        for body, links in zip(self.names, bodies.links):
+            vertices = self.vertices[body]
+            if color_by == 'body':
+                parts = [(body, np.arange(len(vertices)))]
+            else:
+                parts = [(link.name, np.nonzero((vertices >= link.first_vertex) &
+                                                (vertices < link.first_vertex + link.vertex_count))[0])
+                         for link in links if link.vertex_count > 0]
+            groups[body] = []
+            for name, rows in parts:
+                groups[body].append((name, colors.get(name, PALETTE[used % len(PALETTE)]), rows))
+                used += 1
+        return groups
 
     def on_states(self, message):
         q = {state.name: tuple(state.q) for state in message.states}
@@ -101,17 +129,21 @@ class VertexMarkers(object):
             if name not in states:
                 continue
             positions, J = self.client.vertex_jacobians(name, q=states[name], vertices=self.vertices[name])
-            marker = Marker(type=Marker.POINTS, action=Marker.ADD, ns='vertices/' + name, id=index)
-            marker.header.frame_id = self.fixed_frame
-            marker.header.stamp = stamp
-            marker.pose.orientation.w = 1.0
-            marker.scale.x = marker.scale.y = self.point_size
-            marker.color = ColorRGBA(*(list(self.colors[name]) + [1.0]))
-            marker.points = to_points(positions)
-            markers.markers.append(marker)
-            if self.column >= 0:
+            for part, (label, colour, rows) in enumerate(self.groups[name]):
+                # ns 'vertices/<body>', or 'vertices/<body>/<link>' for a body's other links
+                ns = 'vertices/' + name + ('' if label == name else '/' + label)
+                marker = Marker(type=Marker.POINTS, action=Marker.ADD, ns=ns, id=part)
+                marker.header.frame_id = self.fixed_frame
+                marker.header.stamp = stamp
+                marker.pose.orientation.w = 1.0
+                marker.scale.x = marker.scale.y = self.point_size
+                marker.color = ColorRGBA(*(list(colour) + [1.0]))
+                marker.points = to_points(positions[rows])
+                markers.markers.append(marker)
+            if 0 <= self.column < self.dofs[name]:
                 arrows = Marker(type=Marker.LINE_LIST, action=Marker.ADD, ns='jacobian/' + name, id=index)
-                arrows.header = marker.header
+                arrows.header.frame_id = self.fixed_frame
+                arrows.header.stamp = stamp
                 arrows.pose.orientation.w = 1.0
                 arrows.scale.x = 0.0015
                 arrows.color = ColorRGBA(0.2, 1.0, 0.2, 1.0)
