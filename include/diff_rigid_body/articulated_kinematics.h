@@ -23,6 +23,7 @@
 // move (composite inertia of the deeper one's subtree).
 #pragma once
 
+#include <cmath>
 #include <vector>
 
 #include <Eigen/Core>
@@ -91,6 +92,35 @@ Matrix3<Scalar> axisRotation(const Eigen::Vector3d& a, const Scalar& s)
   return R;
 }
 
+/// k for an axis that is exactly +-e_k (as most URDF axes are), else -1.
+inline int coordinateAxis(const Eigen::Vector3d& a)
+{
+  for (int k = 0; k < 3; ++k)
+    if (std::abs(a[k]) == 1.0)
+      return k;
+  return -1;
+}
+
+/// R * rotation(s about the unit axis a), with R the joint frame's rotation.
+/// For a = +-e_k only two columns change (i, j, k cyclic, sigma = a_k):
+///   col_i' = c col_i + sigma s col_j,   col_j' = c col_j - sigma s col_i.
+template <typename Scalar>
+Matrix3<Scalar> rotateAboutJointAxis(const Matrix3<Scalar>& R, const Eigen::Vector3d& a, const Scalar& s)
+{
+  const int k = coordinateAxis(a);
+  if (k < 0)
+    return R * axisRotation(a, s);
+  using std::cos;
+  using std::sin;
+  const Scalar c = cos(s), sn = Scalar(a[k]) * sin(s);
+  const int i = (k + 1) % 3, j = (k + 2) % 3;
+  Matrix3<Scalar> out;
+  out.col(k) = R.col(k);
+  out.col(i) = c * R.col(i) + sn * R.col(j);
+  out.col(j) = c * R.col(j) - sn * R.col(i);
+  return out;
+}
+
 /// a . b without conjugation (Eigen's dot and cross conjugate complex
 /// scalars, which would break complex-step derivatives; detail::cross of
 /// body_pose.h does not).
@@ -145,7 +175,7 @@ ArticulatedPose<Scalar> articulatedPose(const ArticulatedBody& body, const Scala
     Twist<Scalar>& twist = pose.joint_twists[s];
     if (segment.motion == JointMotion::Revolute)
     {
-      frame.R = joint_R * detail::axisRotation(segment.axis, value);
+      frame.R = detail::rotateAboutJointAxis(joint_R, segment.axis, value);
       frame.p = joint_p;
       twist.w = axis;
       twist.v = detail::cross(axis, Vector3<Scalar>(pose.reference - joint_p));

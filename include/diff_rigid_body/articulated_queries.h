@@ -4,9 +4,12 @@
 //   J_v = dp_v/dx = V_s + W_s x (p_v - r), column by column, for vertex v of
 //         segment s; V_s, W_s (3 x dof) sum m_j v_j and m_j w_j over the
 //         joints j on the path to s, per coordinate
-//   dL/dx = sum_v J_v^T g_v = sum_s V_s^T G_s + W_s^T H_s,
-//           G_s = sum g_v,  H_s = sum (p_v - r) x g_v over s's vertices
-// so backprop costs one pass over the vertices plus O(segments x dof).
+//   dL/dx = sum_v J_v^T g_v: with G_s = sum g_v and H_s = sum (p_v - r) x g_v
+//           over the vertices of segment s's subtree, coordinate c gets
+//           sum m_j (v_j . G_s + w_j . H_s) over the joints j (of segments s)
+//           that it drives, and a floating root's Euler angle k gets
+//           T_k . H_root and its translation G_root;
+// so backprop costs one pass over the vertices plus O(segments).
 #pragma once
 
 #include <cstdint>

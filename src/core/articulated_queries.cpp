@@ -4,6 +4,8 @@
 
 #include <unsupported/Eigen/AutoDiff>
 
+#include "diff_rigid_body/detail/backprop_sums.h"
+
 namespace diff_rigid_body
 {
 std::size_t ArticulatedBody::segmentOfVertex(std::uint32_t v) const
@@ -75,26 +77,6 @@ std::vector<SegmentMotion> segmentMotions(const ArticulatedBody& body, const Art
   return motions;
 }
 
-/// G = sum g_i and W = sum g_i p_i^T over `count` vertices (g, p: 3 x count,
-/// column-major), in blocks of 4 columns with two accumulators so that the
-/// products are unrolled and vectorised.
-void gradientMoments(const double* gradients, const double* points, Eigen::Index count, Eigen::Vector3d& G,
-                     Eigen::Matrix3d& W)
-{
-  const Eigen::Map<const Eigen::Matrix3Xd> g(gradients, 3, count), p(points, 3, count);
-  Eigen::Matrix3d W0 = Eigen::Matrix3d::Zero(), W1 = Eigen::Matrix3d::Zero();
-  Eigen::Index i = 0;
-  for (; i + 8 <= count; i += 8)
-  {
-    W0.noalias() += g.middleCols<4>(i) * p.middleCols<4>(i).transpose();
-    W1.noalias() += g.middleCols<4>(i + 4) * p.middleCols<4>(i + 4).transpose();
-  }
-  for (; i < count; ++i)
-    W0.noalias() += g.col(i) * p.col(i).transpose();
-  W = W0 + W1;
-  G = g.rowwise().sum();
-}
-
 /// Calls visit(vertex slot k, vertex index v, segment s) for the selected vertices.
 template <typename Visit>
 void forEachVertex(const ArticulatedBody& body, const std::vector<std::uint32_t>& vertices, Visit visit)
@@ -148,7 +130,7 @@ void articulatedVertexJacobians(const ArticulatedBody& body, const ArticulatedPo
 void articulatedBackprop(const ArticulatedBody& body, const ArticulatedPose<double>& pose,
                          const std::vector<std::uint32_t>& vertices, const double* gradients, double* gradient)
 {
-  // Per segment: G = sum g and H = sum (p - r) x g, and dL/dx = sum_s V_s^T G_s + W_s^T H_s.
+  // Per segment: G = sum g and H = sum (p - r) x g (see articulated_queries.h).
   // With p - r = R p0 + (p_s - r) and W = sum g p0^T (for a whole segment one
   // pass over its vertices), A = sum g (R p0)^T = W R^T gives
   // sum (R p0) x g = (A_zy - A_yz, A_xz - A_zx, A_yx - A_xy).
@@ -158,9 +140,14 @@ void articulatedBackprop(const ArticulatedBody& body, const ArticulatedPose<doub
   if (vertices.empty())
     for (std::size_t s = 0; s < n; ++s)
     {
+      // The free body's summation engine (detail/backprop_sums.h): W[3a + b] = sum g_a p0_b, then G.
       const Segment& segment = body.segments[s];
-      gradientMoments(gradients + 3 * std::size_t(segment.vertex_begin), body.vertices.col(segment.vertex_begin).data(),
-                      segment.vertex_count, G[s], outer[s]);
+      const detail::GradientSums12 sums =
+          detail::gradientSums(detail::ByVertex{ body.vertices.col(segment.vertex_begin).data() },
+                               detail::ByVertex{ gradients + 3 * std::size_t(segment.vertex_begin) },
+                               segment.vertex_count);
+      outer[s] = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(sums.data());
+      G[s] << sums[9], sums[10], sums[11];
     }
   else
     for (std::size_t k = 0; k < vertices.size(); ++k)
@@ -170,15 +157,34 @@ void articulatedBackprop(const ArticulatedBody& body, const ArticulatedPose<doub
       G[s] += g;
       outer[s].noalias() += g * body.vertices.col(vertices[k]).transpose();
     }
-  const std::vector<SegmentMotion> motions = segmentMotions(body, pose);
-  Eigen::Map<Eigen::VectorXd> result(gradient, static_cast<Eigen::Index>(body.dofs()));
-  result.setZero();
+  std::vector<Eigen::Vector3d> H(n);
   for (std::size_t s = 0; s < n; ++s)
   {
     const Eigen::Matrix3d A = outer[s] * pose.frames[s].R.transpose();
-    const Eigen::Vector3d H = Eigen::Vector3d(A(2, 1) - A(1, 2), A(0, 2) - A(2, 0), A(1, 0) - A(0, 1)) +
-                              (pose.frames[s].p - pose.reference).cross(G[s]);
-    result.noalias() += motions[s].V.transpose() * G[s] + motions[s].W.transpose() * H;
+    H[s] = Eigen::Vector3d(A(2, 1) - A(1, 2), A(0, 2) - A(2, 0), A(1, 0) - A(0, 1)) +
+           (pose.frames[s].p - pose.reference).cross(G[s]);
+  }
+  // Subtree sums (children come after their parents), then each joint's
+  // coordinate gets m_j (v_j . G + w_j . H) of the subtree it moves.
+  for (std::size_t s = n; s-- > 1;)
+  {
+    const std::size_t parent = static_cast<std::size_t>(body.segments[s].parent);
+    G[parent] += G[s];
+    H[parent] += H[s];
+  }
+  std::fill(gradient, gradient + body.dofs(), 0.0);
+  if (body.floating_root)
+    for (int k = 0; k < 3; ++k)
+    {
+      gradient[k] = pose.root_T.col(k).dot(H[0]);
+      gradient[k + 3] = G[0][k];
+    }
+  for (std::size_t s = 0; s < n; ++s)
+  {
+    const Segment& segment = body.segments[s];
+    if (segment.coordinate >= 0)
+      gradient[segment.coordinate] +=
+          segment.multiplier * (pose.joint_twists[s].v.dot(G[s]) + pose.joint_twists[s].w.dot(H[s]));
   }
 }
 
