@@ -8,8 +8,7 @@
 // Methods: ours (articulatedPose, then the kernel: what SceneQueries runs per
 // configuration), ours_derivatives (dM/dx), node_call (the SceneQueries call:
 // checks, answer vectors, kernel), ours_kernel (the pose made outside the
-// loop), reference_sums12 (backprop through the 12 sums per segment,
-// articulated_prototypes.h), kdl, mujoco, mujoco_fwdPosition, and floors
+// loop), kdl, mujoco, mujoco_fwdPosition, and floors
 // (loops that only move the kernel's bytes, memory_floors.h). Each benchmark
 // reports the counter "items" (matrices or vertices per iteration): time per
 // item = time / items. Errors (articulated_errors.h) and the models' sizes
@@ -25,7 +24,6 @@
 
 #include "articulated_errors.h"
 #include "articulated_peers.h"
-#include "articulated_prototypes.h"
 #include "diff_rigid_body/articulated_queries.h"
 #include "memory_floors.h"
 
@@ -178,10 +176,9 @@ struct VertexWork
 {
   std::size_t count, dofs;
   std::vector<double> positions, jacobians, gradients, dLdx;
-  drb::VertexColumns<double> columns;  ///< the vertices by coordinate (backpropBySums)
   explicit VertexWork(const drb::ArticulatedBody& body)
     : count(static_cast<std::size_t>(body.vertices.cols())), dofs(body.dofs()), positions(3 * count, 1.0),
-      jacobians(3 * dofs * count, 1.0), gradients(3 * count), dLdx(dofs), columns(body.vertices.transpose())
+      jacobians(3 * dofs * count, 1.0), gradients(3 * count), dLdx(dofs)
   {
     std::mt19937_64 rng(9);
     std::normal_distribution<double> g(0.0, 1.0);
@@ -236,13 +233,6 @@ void registerVertexKernels(const Robot& robot)
       i = (i + 1) % poses.size();
     });
   });
-  // Not on the node's path: the 12 sums per segment (articulated_prototypes.h).
-  add(bp + "reference_sums12", [&robot, body, work, n](benchmark::State& st) {
-    perConfiguration(st, robot, n, [&](const double* x) {
-      backpropBySums(*body, drb::articulatedPose(*body, x), work->columns, work->gradients.data(), work->dLdx.data());
-      benchmark::DoNotOptimize(work->dLdx.data());
-    });
-  });
   add(bp + "floor_read_" + pathName(path), [&robot, body, work, n, path](benchmark::State& st) {
     perConfiguration(st, robot, n, [&](const double*) {
       double sum = readOnce(path, body->vertices, work->gradients.data());
@@ -288,25 +278,6 @@ void describe(const Robot& robot)
   benchmark::AddCustomContext(key + "mujoco.nv", std::to_string(mj.model->nv));
   benchmark::AddCustomContext(key + "mujoco.mass", number(moving));
 #endif
-  if (&robot == &robots()[0])
-  {
-    // backpropBySums against articulatedBackprop: max |difference| / max |dL/dx| over the states.
-    const VertexWork work(body);
-    double diff = 0, scale = 0;
-    std::vector<double> ours(body.dofs()), sums(body.dofs());
-    for (const std::vector<double>& x : robot.states)
-    {
-      const drb::ArticulatedPose<double> pose = drb::articulatedPose(body, x.data());
-      drb::articulatedBackprop(body, pose, {}, work.gradients.data(), ours.data());
-      backpropBySums(body, pose, work.columns, work.gradients.data(), sums.data());
-      for (std::size_t c = 0; c < ours.size(); ++c)
-      {
-        diff = std::max(diff, std::abs(ours[c] - sums[c]));
-        scale = std::max(scale, std::abs(ours[c]));
-      }
-    }
-    benchmark::AddCustomContext(key + "backprop.sums12_vs_ours", number(diff / scale));
-  }
   for (const auto& [name, error] : massMatrixErrors(robot))
     benchmark::AddCustomContext(key + "error." + name, number(error));
 }

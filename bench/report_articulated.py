@@ -104,18 +104,12 @@ def vertex_rows(k, c, targets):
     call, _ = find("backprop", "node_call")
     kernel, _ = find("backprop", "ours_kernel")
     rfloor, rname = find("backprop", "floor_read")
-    sums, _ = find("backprop", "reference_sums12")
-    agree = number(c, "backprop.sums12_vs_ours")
     dofs = int(c["dofs"])
     rows = [row(f"positions + J ({3 + 3 * dofs} doubles per vertex)", NODE_J, jac, wfloor),
             row(f"write floor, `{wname}`: the same bytes stored once", FLOOR, wfloor, wfloor),
             row("backprop dL/dx (pose included)", NODE_BP, bp, rfloor),
             row("backprop, `SceneQueries::backprop` (whole call)", "yes: the node's whole call", call, rfloor),
             row("backprop, pose made outside the loop (kernel alone)", NOT_NODE, kernel, rfloor),
-            row("backprop through the 12 sums per segment (`detail::gradientSums` on each segment's vertices "
-                "by coordinate, bench/articulated_prototypes.h; pose included)"
-                + (f"; ‖Δ‖∞ / ‖dL/dx‖∞ against `articulatedBackprop` {fmt_err(agree)}" if agree is not None
-                   else ""), NOT_NODE, sums, rfloor),
             row(f"read floor, `{rname}`: gradients and vertices read once (48 B per vertex)", FLOOR, rfloor, rfloor)]
     if bp and rfloor:
         r = bp / rfloor
