@@ -48,6 +48,14 @@ struct SegmentMotion
   Eigen::Matrix<double, 3, Eigen::Dynamic> W;
 };
 
+/// V and W restricted to the written columns, rows contiguous, so that a
+/// vertex's J = V + W x d is written row by row with vector operations.
+struct WrittenMotion
+{
+  Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor> V;
+  Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor> W;
+};
+
 std::vector<SegmentMotion> segmentMotions(const ArticulatedBody& body, const ArticulatedPose<double>& pose)
 {
   const Eigen::Index dofs = static_cast<Eigen::Index>(body.dofs());
@@ -106,23 +114,33 @@ void articulatedVertexJacobians(const ArticulatedBody& body, const ArticulatedPo
     for (std::size_t c = 0; c < body.dofs(); ++c)
       all_columns.push_back(static_cast<int>(c));
   const std::vector<int>& written = columns.empty() ? all_columns : columns;
-  const std::size_t width = written.size();
+  const Eigen::Index width = static_cast<Eigen::Index>(written.size());
+  std::vector<WrittenMotion> selected(motions.size());
+  for (std::size_t s = 0; s < motions.size(); ++s)
+  {
+    selected[s].V.resize(3, width);
+    selected[s].W.resize(3, width);
+    for (Eigen::Index c = 0; c < width; ++c)
+    {
+      selected[s].V.col(c) = motions[s].V.col(written[static_cast<std::size_t>(c)]);
+      selected[s].W.col(c) = motions[s].W.col(written[static_cast<std::size_t>(c)]);
+    }
+  }
   forEachVertex(body, vertices, [&](std::size_t k, std::uint32_t v, std::size_t s) {
     const SegmentFrame<double>& frame = pose.frames[s];
     const Eigen::Vector3d p = frame.R * body.vertices.col(v) + frame.p;
     Eigen::Map<Eigen::Vector3d>(positions + 3 * k) = p;
     if (!jacobians)
       return;
+    // Row i of V + W x d: (w x d)_x = w_y d_z - w_z d_y, and cyclically.
     const Eigen::Vector3d d = p - pose.reference;
-    const SegmentMotion& motion = motions[s];
-    double* out = jacobians + 3 * width * k;
-    for (std::size_t c = 0; c < width; ++c)
+    const double *V = selected[s].V.data(), *W = selected[s].W.data();
+    double* J = jacobians + 3 * width * k;
+    for (Eigen::Index c = 0; c < width; ++c)
     {
-      const Eigen::Vector3d w = motion.W.col(written[c]);
-      const Eigen::Vector3d v_col = motion.V.col(written[c]);
-      out[c] = v_col[0] + (w[1] * d[2] - w[2] * d[1]);
-      out[width + c] = v_col[1] + (w[2] * d[0] - w[0] * d[2]);
-      out[2 * width + c] = v_col[2] + (w[0] * d[1] - w[1] * d[0]);
+      J[c] = V[c] + (d[2] * W[width + c] - d[1] * W[2 * width + c]);
+      J[width + c] = V[width + c] + (d[0] * W[2 * width + c] - d[2] * W[c]);
+      J[2 * width + c] = V[2 * width + c] + (d[1] * W[c] - d[0] * W[width + c]);
     }
   });
 }
