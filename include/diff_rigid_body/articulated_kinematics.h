@@ -171,7 +171,9 @@ ArticulatedPose<Scalar> articulatedPose(const ArticulatedBody& body, const Scala
     else
       pose.reference = joint_p;
     const Scalar value = detail::jointValue(segment, x);
-    const Vector3<Scalar> axis = joint_R * segment.axis.template cast<Scalar>();
+    const int k = detail::coordinateAxis(segment.axis);
+    const Vector3<Scalar> axis = k >= 0 ? Vector3<Scalar>(Scalar(segment.axis[k]) * joint_R.col(k)) :
+                                          Vector3<Scalar>(joint_R * segment.axis.template cast<Scalar>());
     Twist<Scalar>& twist = pose.joint_twists[s];
     if (segment.motion == JointMotion::Revolute)
     {
@@ -244,8 +246,18 @@ std::vector<SpatialInertia<Scalar>> compositeInertias(const ArticulatedBody& bod
       SpatialInertia<Scalar> self;
       self.m = m;
       self.h = m * d;
-      self.I = frame.R * castMatrix<Scalar>(own.inertia) * frame.R.transpose();
-      self.I += m * (dot3(d, d) * Matrix3<Scalar>::Identity() - d * d.transpose());
+      // R I R^T + m (|d|^2 I3 - d d^T), symmetric: the upper triangle, mirrored.
+      const Matrix3<Scalar> RI = frame.R * castMatrix<Scalar>(own.inertia);
+      const Scalar d2 = dot3(d, d);
+      for (int i = 0; i < 3; ++i)
+        for (int j = i; j < 3; ++j)
+        {
+          self.I(i, j) = RI(i, 0) * frame.R(j, 0) + RI(i, 1) * frame.R(j, 1) + RI(i, 2) * frame.R(j, 2) -
+                         m * d[i] * d[j];
+          self.I(j, i) = self.I(i, j);
+        }
+      for (int i = 0; i < 3; ++i)
+        self.I(i, i) += m * d2;
       c.add(self);
     }
     const int parent = body.segments[s].parent;
