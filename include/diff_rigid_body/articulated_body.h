@@ -67,8 +67,8 @@ struct ArticulatedBody
 {
   std::string name;  ///< the root segment's link
   bool floating_root = false;
-  /// Parents before children; segments[0] is the root. Segments are in URDF
-  /// document order of their links, except that a parent always comes first.
+  /// Segments in URDF document order of their links, except that a parent
+  /// always comes before its children; segments[0] is the root.
   std::vector<Segment> segments;
   /// Every vertex in its segment's frame [m]; each segment's are contiguous.
   Matrix3X<double> vertices;

@@ -23,6 +23,7 @@
 // move (composite inertia of the deeper one's subtree).
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <vector>
 

@@ -161,7 +161,7 @@ void articulatedBackprop(const ArticulatedBody& body, const ArticulatedPose<doub
       // The free body's summation engine (detail/backprop_sums.h): W[3a + b] = sum g_a p0_b, then G.
       const Segment& segment = body.segments[s];
       const detail::GradientSums12 sums =
-          detail::gradientSums(detail::ByVertex{ body.vertices.col(segment.vertex_begin).data() },
+          detail::gradientSums(detail::ByVertex{ body.vertices.data() + 3 * std::size_t(segment.vertex_begin) },
                                detail::ByVertex{ gradients + 3 * std::size_t(segment.vertex_begin) },
                                segment.vertex_count);
       outer[s] = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(sums.data());

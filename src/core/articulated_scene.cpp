@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <queue>
 #include <sstream>
 
 #include "diff_rigid_body/exceptions.h"
@@ -13,40 +14,30 @@ namespace diff_rigid_body
 {
 namespace detail
 {
-namespace
-{
-bool isOneDof(int type)
-{
-  return type == urdf::Joint::REVOLUTE || type == urdf::Joint::CONTINUOUS || type == urdf::Joint::PRISMATIC;
-}
-}  // namespace
-
-// The segments of the tree under `root_name`: the root, then depth first,
-// children in document order of their links (parents before children).
+// The segments of the tree under `root_name` in document order of their
+// links, except that a parent always comes before its children: the next
+// segment is the earliest in the document among those whose parent is placed.
 std::vector<std::string> SceneBuilder::treeSegments(const std::string& root_name) const
 {
+  using Ready = std::pair<std::size_t, std::string>;  // (document index, link)
+  std::priority_queue<Ready, std::vector<Ready>, std::greater<Ready>> ready;
+  ready.emplace(link_document_index_.at(root_name), root_name);
   std::vector<std::string> order;
-  std::vector<std::string> stack{ root_name };
-  while (!stack.empty())
+  while (!ready.empty())
   {
-    const std::string segment = std::move(stack.back());
-    stack.pop_back();
+    const std::string segment = ready.top().second;
+    ready.pop();
     order.push_back(segment);
     // Child segments: 1-dof joints below the segment's link or its merged links.
-    std::vector<std::string> children;
     std::vector<urdf::LinkConstSharedPtr> rigid{ model_->getLink(segment) };
     for (std::size_t k = 0; k < rigid.size(); ++k)
       for (const urdf::JointSharedPtr& joint : rigid[k]->child_joints)
       {
         if (joint->type == urdf::Joint::FIXED)
           rigid.push_back(model_->getLink(joint->child_link_name));
-        else if (isOneDof(joint->type))
-          children.push_back(joint->child_link_name);
+        else if (movesOneCoordinate(joint->type))
+          ready.emplace(link_document_index_.at(joint->child_link_name), joint->child_link_name);
       }
-    std::sort(children.begin(), children.end(), [this](const std::string& a, const std::string& b) {
-      return link_document_index_.at(a) > link_document_index_.at(b);  // reversed: popped in order
-    });
-    stack.insert(stack.end(), children.begin(), children.end());
   }
   return order;
 }
@@ -87,7 +78,7 @@ SceneBody SceneBuilder::buildArticulatedBody(const std::string& root_name, const
   scene_body.joint_type = jointTypeName(root_joint->type);
   ArticulatedBody body;
   body.name = root_name;
-  body.floating_root = !isOneDof(root_joint->type);
+  body.floating_root = !movesOneCoordinate(root_joint->type);
 
   std::unordered_map<std::string, std::size_t> segment_index;
   std::vector<Matrix3X<double>> vertex_blocks;

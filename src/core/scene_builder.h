@@ -22,6 +22,13 @@ namespace diff_rigid_body
 {
 namespace detail
 {
+/// Revolute, continuous and prismatic joints: one coordinate each.
+inline bool movesOneCoordinate(int joint_type)
+{
+  return joint_type == urdf::Joint::REVOLUTE || joint_type == urdf::Joint::CONTINUOUS ||
+         joint_type == urdf::Joint::PRISMATIC;
+}
+
 class SceneBuilder
 {
 public:

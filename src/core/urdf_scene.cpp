@@ -20,15 +20,6 @@ namespace diff_rigid_body
 {
 namespace detail
 {
-namespace
-{
-bool movesOneCoordinate(int joint_type)
-{
-  return joint_type == urdf::Joint::REVOLUTE || joint_type == urdf::Joint::CONTINUOUS ||
-         joint_type == urdf::Joint::PRISMATIC;
-}
-}  // namespace
-
 Scene SceneBuilder::build()
 {
   Scene scene;

@@ -255,3 +255,32 @@ TEST(ArticulatedScene, AllVertexPathsAgreeWithIndexListsAndJTransposeG)
     EXPECT_NEAR(grad_list[c], jtg, 1e-14 * scale) << "coordinate " << c;
   }
 }
+
+// Links A, B, C, D in document order, B and C children of A, D a child of B:
+// segments (and vertex ranges) follow the document, A B C D, not depth first
+// (A B D C). D has no geometry: the last segment is empty, which every
+// all-vertex path must take.
+TEST(ArticulatedScene, SegmentsFollowTheDocumentWithParentsFirst)
+{
+  const std::string xml =
+      robot(rodLink("A", 1, 0, 0.1) + rodLink("B", 1, 0, 0.1) + rodLink("C", 1, 0, 0.1) +
+            link("D", inertial("0.5")) + oneDofJoint("A_joint", "revolute", "world", "A", "", "0 0 1") +
+            oneDofJoint("B_joint", "revolute", "A", "B", "<origin xyz=\"1 0 0\"/>", "0 0 1") +
+            oneDofJoint("C_joint", "revolute", "A", "C", "<origin xyz=\"0 1 0\"/>", "0 0 1") +
+            oneDofJoint("D_joint", "revolute", "B", "D", "<origin xyz=\"1 0 0\"/>", "0 0 1"));
+  const drb::Scene scene = drb::loadSceneFromUrdf(xml);
+  const drb::ArticulatedBody& tree = *scene.bodies.at(0).articulated;
+  ASSERT_EQ(tree.segments.size(), 4u);
+  EXPECT_EQ(tree.segments[1].link, "B");
+  EXPECT_EQ(tree.segments[2].link, "C");
+  EXPECT_EQ(tree.segments[3].link, "D");
+  EXPECT_EQ(tree.segments[3].parent, 1);
+  EXPECT_EQ(tree.segments[3].vertex_count, 0u);
+  const double x[4] = { 0.1, 0.2, 0.3, 0.4 };
+  const drb::ArticulatedPose<double> pose = drb::articulatedPose(tree, x);
+  const std::vector<double> g(3 * static_cast<std::size_t>(tree.vertices.cols()), 1.0);
+  std::vector<double> gradient(4);
+  drb::articulatedBackprop(tree, pose, {}, g.data(), gradient.data());
+  EXPECT_EQ(gradient[3], 0.0) << "D moves no vertex";
+  EXPECT_TRUE(Eigen::Map<const Eigen::Vector4d>(gradient.data()).allFinite());
+}
