@@ -57,11 +57,14 @@ inline std::vector<int> compactColumnList(const ArticulatedBody& body)
   return columns;
 }
 
-/// Whether every segment frame, the reference point and a floating root's T are finite.
+/// Whether every segment frame, joint twist, the reference point and a floating root's T are finite.
 inline bool poseIsFinite(const ArticulatedBody& body, const ArticulatedPose<double>& pose)
 {
   for (const SegmentFrame<double>& frame : pose.frames)
     if (!frame.R.allFinite() || !frame.p.allFinite())
+      return false;
+  for (std::size_t s = 0; s < pose.joint_twists.size(); ++s)
+    if (body.segments[s].coordinate >= 0 && !(pose.joint_twists[s].w.allFinite() && pose.joint_twists[s].v.allFinite()))
       return false;
   return pose.reference.allFinite() && (!body.floating_root || pose.root_T.allFinite());
 }

@@ -9,6 +9,7 @@
 
 #include "diff_rigid_body/exceptions.h"
 #include "request_checks.h"
+#include "scene_queries_articulated.h"
 
 namespace diff_rigid_body
 {
@@ -17,6 +18,15 @@ using detail::sizeMismatch;
 
 namespace
 {
+/// Refuses an articulated body's x whose link poses overflow (a prismatic
+/// joint at 1e308, say): tf would otherwise publish inf. Free bodies keep
+/// version 1's rule (q finite).
+void requireFinitePoses(const SceneBody& body, const Eigen::VectorXd& x, const std::string& field)
+{
+  if (body.articulated && !detail::poseIsFinite(*body.articulated, articulatedPose(*body.articulated, x.data())))
+    reject(field + ": the link poses of body '" + body.body.name + "' overflow at these values");
+}
+
 // At most 64 bytes of a name for a message: a hostile name may be huge.
 std::string shortened(const std::string& name)
 {
@@ -86,6 +96,7 @@ SceneState SceneQueries::applyStates(const SceneState& current, const std::vecto
       reject(sizeMismatch(q_field, std::to_string(dofs) + " values (the body's dofs)",
                           static_cast<std::size_t>(updates[i].q.size())));
     requireFinite(updates[i].q.data(), dofs, q_field);
+    requireFinitePoses(scene_.bodies[index], updates[i].q, q_field);
     indices.push_back(index);
   }
   SceneState next = current;
@@ -110,14 +121,22 @@ SceneState SceneQueries::applyJointPositions(const SceneState& current, const st
       reject(why.str());
     }
   SceneState next = current;
+  std::vector<std::size_t> changed;
   for (std::size_t i = 0; i < names.size(); ++i)
   {
     const auto found = joint_index_.find(names[i]);
     if (found != joint_index_.end())
+    {
       next[found->second.first][static_cast<Eigen::Index>(found->second.second)] = positions[i];
+      changed.push_back(found->second.first);
+    }
     else if (mimic_joints_.count(names[i]) == 0)
       unknown_names.push_back(names[i]);
   }
+  std::sort(changed.begin(), changed.end());
+  changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
+  for (std::size_t index : changed)
+    requireFinitePoses(scene_.bodies[index], next[index], "position");
   return next;
 }
 

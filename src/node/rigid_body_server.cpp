@@ -96,11 +96,13 @@ RigidBodyServer::StatePtr RigidBodyServer::snapshot() const
   return state_;
 }
 
-void RigidBodyServer::commit(const std::function<SceneState(const SceneState&)>& change)
+void RigidBodyServer::commit(const std::function<SceneState(const SceneState&)>& change, bool only_if_changed)
 {
   std::lock_guard<std::mutex> write(write_mutex_);
   const StatePtr previous = snapshot();
   auto next = std::make_shared<const SceneState>(change(*previous));
+  if (only_if_changed && *next == *previous)
+    return;
   if (!state_file_.empty())
     writeStateFile(state_file_, queries_.scene(), *next);  // durable before it is visible or acknowledged
   {
@@ -311,10 +313,10 @@ void RigidBodyServer::onJointStates(const sensor_msgs::JointState::ConstPtr& mes
       std::vector<std::string> unknown;
       SceneState next = queries_.applyJointPositions(current, message->name, message->position, unknown);
       for (const std::string& name : unknown)  // under the writer mutex, which guards the set
-        if (unknown_joints_logged_.insert(name).second)
+        if (unknown_joints_logged_.size() < kMaxLoggedUnknownJoints && unknown_joints_logged_.insert(name).second)
           ROS_WARN_STREAM("joint_states: ignoring joint '" << name << "', which no body has (logged once)");
       return next;
-    });
+    }, /*only_if_changed=*/true);  // a driver streaming an arm at rest costs no state-file write
   }
   catch (const Error& e)
   {

@@ -73,7 +73,8 @@ private:
   StatePtr snapshot() const;
   /// Under the writer mutex: next = change(current) (throws to refuse, all
   /// or nothing), saved to ~state_file if set, swapped in, then published.
-  void commit(const std::function<SceneState(const SceneState&)>& change);
+  /// With only_if_changed, a next equal to the current state is dropped.
+  void commit(const std::function<SceneState(const SceneState&)>& change, bool only_if_changed = false);
   /// Validates and applies named states (all or nothing), then publishes them.
   void applyStates(const std::vector<BodyState>& states);
   /// Writes the frame ids and names of the outgoing messages, and their
@@ -136,6 +137,8 @@ private:
   ros::Subscriber joint_states_subscriber_;
   /// Unknown joint names already logged (guarded by write_mutex_).
   std::set<std::string> unknown_joints_logged_;
+  /// Distinct unknown joint names logged at most (a hostile publisher cannot grow the set).
+  static constexpr std::size_t kMaxLoggedUnknownJoints = 1000;
   std::vector<ros::ServiceServer> services_;
   ros::Timer timer_;
 };

@@ -9,6 +9,7 @@
 
 #include "diff_rigid_body/articulated_queries.h"
 #include "diff_rigid_body/exceptions.h"
+#include "diff_rigid_body/scene_queries.h"
 #include "diff_rigid_body/urdf_scene.h"
 #include "../support/expect_throws.h"
 #include "../support/urdf_builders.h"
@@ -283,4 +284,25 @@ TEST(ArticulatedScene, SegmentsFollowTheDocumentWithParentsFirst)
   drb::articulatedBackprop(tree, pose, {}, g.data(), gradient.data());
   EXPECT_EQ(gradient[3], 0.0) << "D moves no vertex";
   EXPECT_TRUE(Eigen::Map<const Eigen::Vector4d>(gradient.data()).allFinite());
+}
+
+// A finite x whose link poses overflow (a slider at 1e308 plus its origin)
+// is refused by set_state and joint_states alike, naming the body; the
+// state is unchanged.
+TEST(ArticulatedScene, StatesWhoseLinkPosesOverflowAreRefused)
+{
+  const std::string xml = robot(rodLink("rail", 1, 0, 0.1) + rodLink("cart", 1, 0, 0.1) +
+                                oneDofJoint("rail_joint", "revolute", "world", "rail", "", "0 0 1") +
+                                oneDofJoint("cart_joint", "prismatic", "rail", "cart",
+                                            "<origin xyz=\"1e308 0 0\"/>", "1 0 0"));
+  const drb::SceneQueries queries(drb::loadSceneFromUrdf(xml));
+  const drb::SceneState start = queries.initialState();
+  drb::NamedState huge{ "rail", Eigen::Vector2d(0.0, 1e308) };
+  DRB_EXPECT_THROWS_MESSAGE(queries.applyStates(start, { huge }), drb::InvalidArgumentError,
+                            "states[0].q (body 'rail'): the link poses of body 'rail' overflow");
+  std::vector<std::string> unknown;
+  DRB_EXPECT_THROWS_MESSAGE(queries.applyJointPositions(start, { "cart_joint" }, { 1e308 }, unknown),
+                            drb::InvalidArgumentError, "position: the link poses of body 'rail' overflow");
+  const drb::SceneState moved = queries.applyJointPositions(start, { "cart_joint" }, { 2.0 }, unknown);
+  EXPECT_EQ(moved[0][1], 2.0);
 }
