@@ -26,8 +26,14 @@ struct RequestLimits
 {
   /// Vertices in one get_vertex_jacobians or backprop request, over all its
   /// configurations (K x N for K configurations of N vertices; positions and
-  /// Jacobians of 2^22 vertices take 640 MiB). Also the most configurations.
+  /// Jacobians of 2^22 vertices of a free body take 640 MiB). Also the most
+  /// configurations.
   static constexpr std::size_t kMaxVertices = std::size_t(1) << 22;
+  /// Doubles that a vertex request on an articulated body may need: its
+  /// answer, 3 (1 + d) per vertex and configuration, and its motion
+  /// matrices, 6 d per segment. The free body's 21 per vertex times
+  /// kMaxVertices (640 MiB).
+  static constexpr std::size_t kMaxArticulatedDoubles = 21 * kMaxVertices;
   /// Mass matrices (configurations x bodies) of 6-dof bodies in one
   /// get_mass_matrix request; with derivatives each costs 252 doubles (2 KiB).
   static constexpr std::size_t kMaxMassMatrices = 1000000;
@@ -166,8 +172,13 @@ public:
 
 private:
   /// K for a request's `q` (empty = 1, else its size / d), checked against
-  /// its size (a multiple of d = `dofs`) and the vertex limit for K x `vertex_count`.
-  std::size_t configurationCount(const std::vector<double>& q, std::size_t dofs, std::size_t vertex_count) const;
+  /// its size (a multiple of d = dofs(index)), the vertex limit for K x
+  /// `vertex_count` and, for an articulated body, its work limit.
+  std::size_t configurationCount(const std::vector<double>& q, std::size_t index, std::size_t vertex_count) const;
+  /// Refuses a vertex request on articulated body `index` whose answer
+  /// (3 (1 + d) doubles per vertex and configuration) or per-segment motion
+  /// matrices (6 d per segment) exceed RequestLimits::kMaxArticulatedDoubles.
+  void checkArticulatedWork(std::size_t index, std::size_t configurations, std::size_t vertex_count) const;
   /// The d values of configuration k of body `index`: q + d k, or the current state when `q` is empty.
   const double* configurationQ(const SceneState& current, std::size_t index, const std::vector<double>& q,
                                std::size_t k) const;

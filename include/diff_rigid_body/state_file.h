@@ -46,6 +46,11 @@ public:
 /// scene. A bigger file is refused before it is read.
 std::size_t maxStateFileSize(std::size_t body_count);
 
+/// Largest state file read for `scene`: maxStateFileSize(bodies) plus 32
+/// bytes for every coordinate beyond 6 of a body (a hex float and a space
+/// take at most 25), so that what writeStateFile writes is always read back.
+std::size_t maxStateFileSize(const Scene& scene);
+
 /// 64-bit FNV-1a over what the state means for a scene: the fixed frame and,
 /// per body in order, its name, mass, inertia, COM offset and body-frame
 /// vertices (their IEEE bits), and for an articulated body its tree: per

@@ -81,9 +81,11 @@ std::size_t SceneQueries::checkVertices(std::size_t index, const std::vector<std
   return count;
 }
 
-std::size_t SceneQueries::configurationCount(const std::vector<double>& q, std::size_t dofs,
+std::size_t SceneQueries::configurationCount(const std::vector<double>& q, std::size_t index,
                                              std::size_t vertex_count) const
 {
+  const std::size_t dofs = this->dofs(index);
+  checkArticulatedWork(index, q.empty() ? 1 : q.size() / dofs, vertex_count);
   if (q.empty())
     return 1;
   const std::string d = std::to_string(dofs);
@@ -103,6 +105,26 @@ std::size_t SceneQueries::configurationCount(const std::vector<double>& q, std::
     reject(why.str());
   }
   return configurations;
+}
+
+void SceneQueries::checkArticulatedWork(std::size_t index, std::size_t configurations,
+                                        std::size_t vertex_count) const
+{
+  const ArticulatedBody* body = scene_.bodies[index].articulated.get();
+  if (!body || configurations > RequestLimits::kMaxVertices || vertex_count > RequestLimits::kMaxVertices)
+    return;  // free bodies: version 1's limits; the vertex limit refuses the rest
+  // Products of values below 2^22 and of dof x segments (each far below 2^32): no wrap.
+  const double answer = 3.0 * double(configurations) * double(vertex_count) * double(1 + body->dofs());
+  const double motions = 6.0 * double(body->segments.size()) * double(body->dofs());
+  const double budget = double(RequestLimits::kMaxArticulatedDoubles);
+  if (answer > budget || motions > budget)
+  {
+    std::ostringstream why;
+    why << "q, vertices: body '" << scene_.bodies[index].body.name << "' (" << body->dofs() << " coordinates, "
+        << body->segments.size() << " segments) would need " << std::max(answer, motions)
+        << " doubles for this request, more than the limit of " << RequestLimits::kMaxArticulatedDoubles;
+    reject(why.str());
+  }
 }
 
 void SceneQueries::checkPositionsFit(const SceneState& current, std::size_t index, const std::vector<double>& q,
@@ -151,7 +173,7 @@ void SceneQueries::vertexJacobians(const SceneState& current, const std::string&
 {
   const std::size_t index = bodyIndex(body_name, "body");
   const std::size_t count = checkVertices(index, vertices);
-  const std::size_t configurations = configurationCount(q, dofs(index), count);
+  const std::size_t configurations = configurationCount(q, index, count);
   requireFinite(q.data(), q.size(), "q");
   if (scene_.bodies[index].articulated)
   {
@@ -212,7 +234,7 @@ void SceneQueries::vertexRotationJacobians(const SceneState& current, const std:
 {
   const std::size_t index = bodyIndex(body_name, "body");
   const std::size_t count = checkVertices(index, vertices);
-  const std::size_t configurations = configurationCount(q, dofs(index), count);
+  const std::size_t configurations = configurationCount(q, index, count);
   if (const ArticulatedBody* body = scene_.bodies[index].articulated.get())
   {
     requireFinite(q.data(), q.size(), "q");
@@ -259,7 +281,7 @@ std::vector<double> SceneQueries::backpropConfigurations(const SceneState& curre
   const std::size_t index = bodyIndex(body_name, "body");
   const std::size_t count = checkVertices(index, vertices);
   const std::size_t d = dofs(index);
-  const std::size_t configurations = configurationCount(q, d, count);
+  const std::size_t configurations = configurationCount(q, index, count);
   if (gradients.size() != 3 * count * configurations)
   {
     if (configurations == 1)

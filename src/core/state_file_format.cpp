@@ -103,6 +103,14 @@ std::size_t maxStateFileSize(std::size_t body_count)
   return 65536 + 4096 * body_count;
 }
 
+std::size_t maxStateFileSize(const Scene& scene)
+{
+  std::size_t extra_coordinates = 0;
+  for (const SceneBody& body : scene.bodies)
+    extra_coordinates += body.dofs() > 6 ? body.dofs() - 6 : 0;
+  return maxStateFileSize(scene.bodies.size()) + 32 * extra_coordinates;
+}
+
 std::uint64_t sceneFingerprint(const Scene& scene)
 {
   Fnv1a hash;
@@ -180,9 +188,9 @@ struct Lines
 
 Lines splitLines(const std::string& text, const Scene& scene)
 {
-  if (text.size() > maxStateFileSize(scene.bodies.size()))
+  if (text.size() > maxStateFileSize(scene))
     fail("too large: " + std::to_string(text.size()) + " bytes, at most " +
-         std::to_string(maxStateFileSize(scene.bodies.size())) + " for " + std::to_string(scene.bodies.size()) +
+         std::to_string(maxStateFileSize(scene)) + " for " + std::to_string(scene.bodies.size()) +
          " bodies");
   if (text.empty())
     fail("empty file");

@@ -68,7 +68,7 @@ std::optional<SceneState> readStateFile(const std::string& path, const Scene& sc
     ::close(fd);
     fail("state file '" + path + "': not a regular file");
   }
-  const std::size_t limit = maxStateFileSize(scene.bodies.size());
+  const std::size_t limit = maxStateFileSize(scene);
   if (static_cast<std::uint64_t>(info.st_size) > limit)
   {
     ::close(fd);

@@ -306,3 +306,23 @@ TEST(ArticulatedScene, StatesWhoseLinkPosesOverflowAreRefused)
   const drb::SceneState moved = queries.applyJointPositions(start, { "cart_joint" }, { 2.0 }, unknown);
   EXPECT_EQ(moved[0][1], 2.0);
 }
+
+// An articulated body's vertex answer is 3 (1 + d) doubles per vertex and
+// configuration: with d = 8 the free body's vertex limit alone would let
+// 113 M doubles through; the work limit refuses it before anything is allocated.
+TEST(ArticulatedScene, VertexRequestsOverTheWorkLimitAreRefused)
+{
+  const std::string xml =
+      robot(rodLink("torso", 5, 0.1, 0.2) + rodLink("leg", 1, 0, 0.05) + rodLink("foot", 0.5, 0.05, 0.01) +
+            floatingJoint("torso") + oneDofJoint("hip", "revolute", "torso", "leg", "", "0 1 0") +
+            oneDofJoint("ankle", "prismatic", "leg", "foot", "", "1 0 0"));
+  const drb::SceneQueries queries(drb::loadSceneFromUrdf(xml));
+  const std::size_t n = queries.scene().bodies[0].vertexCount(), dofs = queries.dofs(0);
+  ASSERT_EQ(dofs, 8u);
+  const std::size_t configurations = drb::RequestLimits::kMaxVertices / n;  // within the vertex limit
+  const std::vector<double> q(configurations * dofs, 0.0);
+  std::vector<double> positions, jacobians;
+  DRB_EXPECT_THROWS_MESSAGE(queries.vertexJacobians(queries.initialState(), "torso", {}, q, positions, jacobians),
+                            drb::InvalidArgumentError, "more than the limit of 88080384");
+  EXPECT_TRUE(positions.empty() && jacobians.empty());
+}
