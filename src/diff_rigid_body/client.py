@@ -129,7 +129,8 @@ def _indices(vertices):
 
 
 def _pose(q):
-    """A request's optional q: empty = the node's current state, else 6 values."""
+    """A request's optional q: empty = the node's current state, else the body's x (d values,
+    or K d for K configurations)."""
     return [] if q is None else _floats(q)
 
 

@@ -108,8 +108,9 @@ private:
   bool echo(Echo::Request& request, Echo::Response& response);
   void onSetStates(const BodyStateArray::ConstPtr& message);
   /// joint_states: named joints set, unknown names ignored (each logged
-  /// once), a message with a non-finite position or fewer positions than
-  /// names dropped whole with a warning.
+  /// once), a message with a non-finite position, a position count other
+  /// than the name count, or overflowing link poses dropped whole with a
+  /// warning; a message that changes nothing is not committed.
   void onJointStates(const sensor_msgs::JointState::ConstPtr& message);
   void onTimer(const ros::TimerEvent& event);
 
