@@ -11,6 +11,7 @@
 #include "diff_rigid_body/mesh_loader.h"
 #include "identical_positions.h"
 #include "urdf_model.h"
+#include "urdf_topology.h"
 
 namespace diff_rigid_body
 {
@@ -22,6 +23,11 @@ SceneBuilder::SceneBuilder(const std::string& urdf_xml, const SceneOptions& opti
   document_order_ = namesInDocumentOrder(urdf_xml, "link");
   joint_document_order_ = namesInDocumentOrder(urdf_xml, "joint");
   model_ = parseUrdfModel(urdf_xml);
+  std::vector<JointEdge> edges;
+  for (const std::string& name : joint_document_order_)
+    if (const urdf::JointConstSharedPtr joint = model_->getJoint(name))
+      edges.push_back({ name, joint->parent_link_name, joint->child_link_name });
+  checkTreeTopology(document_order_, edges);
   if (!model_->getRoot())
     throw SceneDescriptionError("robot description: no root link");
   if (options_.density && !(std::isfinite(*options_.density) && *options_.density > 0.0))

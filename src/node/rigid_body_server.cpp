@@ -295,20 +295,14 @@ bool RigidBodyServer::backprop(Backprop::Request& request, Backprop::Response& r
 
 void RigidBodyServer::onSetStates(const BodyStateArray::ConstPtr& message)
 {
-  try
-  {
-    applyStates(message->states);
-  }
-  catch (const Error& e)
-  {
-    ROS_WARN_STREAM_THROTTLE(1.0, "set_states: message dropped: " << e.what());
-  }
+  const std::string failure = node::guardCallback("set_states", [&] { applyStates(message->states); });
+  if (!failure.empty())
+    ROS_WARN_STREAM_THROTTLE(1.0, "set_states: message dropped: " << failure);
 }
 
 void RigidBodyServer::onJointStates(const sensor_msgs::JointState::ConstPtr& message)
 {
-  try
-  {
+  const std::string failure = node::guardCallback("joint_states", [&] {
     commit([&](const SceneState& current) {
       std::vector<std::string> unknown;
       SceneState next = queries_.applyJointPositions(current, message->name, message->position, unknown);
@@ -317,19 +311,21 @@ void RigidBodyServer::onJointStates(const sensor_msgs::JointState::ConstPtr& mes
           ROS_WARN_STREAM("joint_states: ignoring joint '" << name << "', which no body has (logged once)");
       return next;
     }, /*only_if_changed=*/true);  // a driver streaming an arm at rest costs no state-file write
-  }
-  catch (const Error& e)
-  {
-    ROS_WARN_STREAM_THROTTLE(1.0, "joint_states: message dropped: " << e.what());
-  }
+  });
+  if (!failure.empty())
+    ROS_WARN_STREAM_THROTTLE(1.0, "joint_states: message dropped: " << failure);
 }
 
 void RigidBodyServer::onTimer(const ros::TimerEvent&)
 {
-  // Under the write lock, so a periodic message never goes out after (and
-  // overrides) a newer state published by a writer.
-  std::lock_guard<std::mutex> write(write_mutex_);
-  publishState(ros::Time::now(), /*state_changed=*/false);
+  const std::string failure = node::guardCallback("the periodic publication", [&] {
+    // Under the write lock, so a periodic message never goes out after (and
+    // overrides) a newer state published by a writer.
+    std::lock_guard<std::mutex> write(write_mutex_);
+    publishState(ros::Time::now(), /*state_changed=*/false);
+  });
+  if (!failure.empty())
+    ROS_ERROR_STREAM_THROTTLE(1.0, "rigid_body_server: " << failure);
 }
 
 // Reduced transport of get_vertex_jacobians; ~ping and ~echo (benchmark only) measure transport (bench/).

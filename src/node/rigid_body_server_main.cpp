@@ -10,6 +10,7 @@
 
 #include "diff_rigid_body/exceptions.h"
 #include "rigid_body_server.h"
+#include "server_helpers.h"
 
 namespace drb = diff_rigid_body;
 
@@ -95,15 +96,8 @@ int main(int argc, char** argv)
   settings.frame_prefix = private_nh.param<std::string>("frame_prefix", "");
 
   drb::Scene scene;
-  try
-  {
-    scene = loadScene(nh, private_nh);
-  }
-  catch (const drb::Error& e)
-  {
-    ROS_FATAL_STREAM("rigid_body_server: cannot load the scene: " << e.what());
+  if (!drb::node::runAtStart("cannot load the scene", [&] { scene = loadScene(nh, private_nh); }))
     return 1;
-  }
   // With ~joints: model only planar joints are left unmodelled, which interface.md asks to warn about;
   // with ~joints: free every 1-dof joint is, by request.
   const bool free_joints = private_nh.param<std::string>("joints", "model") == "free";
@@ -124,15 +118,11 @@ int main(int argc, char** argv)
                                                 << "':" << summary.str());
 
   std::unique_ptr<drb::RigidBodyServer> server;
-  try
-  {
-    server = std::make_unique<drb::RigidBodyServer>(nh, private_nh, std::move(scene), settings);
-  }
-  catch (const drb::Error& e)  // e.g. an unwritable ~state_file
-  {
-    ROS_FATAL_STREAM("rigid_body_server: cannot start: " << e.what());
+  // e.g. an unwritable ~state_file
+  if (!drb::node::runAtStart("cannot start", [&] {
+        server = std::make_unique<drb::RigidBodyServer>(nh, private_nh, std::move(scene), settings);
+      }))
     return 1;
-  }
   ros::MultiThreadedSpinner spinner(static_cast<std::uint32_t>(threads));
   spinner.spin();
   return 0;

@@ -2,8 +2,13 @@
 // wrappers that turn core errors into `success=false, message=...`.
 #pragma once
 
+#include <cstdlib>
+#include <exception>
 #include <string>
+#include <typeinfo>
 #include <vector>
+
+#include <cxxabi.h>
 
 #include <Eigen/Geometry>
 #include <boost/function.hpp>
@@ -31,8 +36,25 @@ inline void setTransform(const Eigen::Isometry3d& pose, geometry_msgs::Transform
   transform.rotation.w = rotation.w();
 }
 
-/// Runs `work`; a core error becomes success=false with its message, so that
-/// the client receives it and nothing else happens. Returns true for roscpp.
+/// The message for an exception caught at a boundary of the node (`where`:
+/// a service, topic, timer or the load): a core Error's own message, which
+/// names what was wrong; any other std::exception, which only a bug of ours
+/// can raise, as "internal error in <where>: <what> (<type>)".
+inline std::string failureMessage(const std::exception& error, const std::string& where)
+{
+  if (dynamic_cast<const Error*>(&error))
+    return error.what();
+  int status = 0;
+  char* type = abi::__cxa_demangle(typeid(error).name(), nullptr, nullptr, &status);
+  const std::string message = "internal error in " + where + ": " + error.what() + " (" +
+                              (status == 0 && type ? type : typeid(error).name()) + ")";
+  std::free(type);
+  return message;
+}
+
+/// Runs `work`; any exception becomes success=false with failureMessage, so
+/// that the client receives it, nothing changed, and the node keeps serving.
+/// Returns true for roscpp.
 template <typename Response, typename Work>
 bool serve(Response& response, const char* service, Work&& work)
 {
@@ -42,21 +64,48 @@ bool serve(Response& response, const char* service, Work&& work)
     response.success = true;
     response.message = "";
   }
-  catch (const Error& e)
+  catch (const std::exception& e)
   {
     response = Response();
     response.success = false;
-    response.message = e.what();
-    ROS_DEBUG_STREAM(service << ": refused: " << e.what());
-  }
-  catch (const std::exception& e)  // e.g. std::bad_alloc: report, keep serving
-  {
-    response = Response();
-    response.success = false;
-    response.message = std::string("internal error: ") + e.what();
-    ROS_ERROR_STREAM(service << ": " << response.message);
+    response.message = failureMessage(e, service);
+    if (dynamic_cast<const Error*>(&e))
+      ROS_DEBUG_STREAM(service << ": refused: " << response.message);
+    else
+      ROS_ERROR_STREAM(service << ": " << response.message);
   }
   return true;
+}
+
+/// Runs a topic or timer callback's `work`. Any exception is caught here, so
+/// that none reaches roscpp (which would end the node): it becomes the
+/// returned message (failureMessage, "" when `work` returned), which the
+/// caller logs, e.g. as "message dropped".
+template <typename Work>
+std::string guardCallback(const char* where, Work&& work)
+{
+  try
+  {
+    work();
+    return std::string();
+  }
+  catch (const std::exception& e)
+  {
+    return failureMessage(e, where);
+  }
+}
+
+/// Runs the node's start-up `work` (loading the scene, starting the server).
+/// Returns false after logging "rigid_body_server: <what>: <failureMessage>"
+/// as FATAL for any exception, so that main exits 1 and never aborts.
+template <typename Work>
+bool runAtStart(const std::string& what, Work&& work)
+{
+  const std::string failure = guardCallback(what.c_str(), std::forward<Work>(work));
+  if (failure.empty())
+    return true;
+  ROS_FATAL_STREAM("rigid_body_server: " << what << ": " << failure);
+  return false;
 }
 
 /// Appends `matrix` row-major to `out`.

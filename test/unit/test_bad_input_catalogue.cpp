@@ -44,6 +44,7 @@ using drb_test::withoutTrailer;
 using drb_test::urdf::collision;
 using drb_test::urdf::floatingJoint;
 using drb_test::urdf::inertial;
+using drb_test::urdf::joint;
 using drb_test::urdf::meshGeometry;
 using drb_test::urdf::oneBody;
 using drb_test::urdf::robot;
@@ -413,6 +414,20 @@ std::vector<Row> urdfRows()
     { "U84", "no <inertial> and no ~density", Expect::Accepted, "", "", loadWithWarning(oneBody(box)) },
     { "U85", "a floating body that starts at pitch pi/2 (gimbal lock)", Expect::Accepted, "", "",
       loadWithWarning(oneBody(I, "<origin rpy=\"0 1.5707963267948966 0\"/>")) },
+    // Joint graphs that urdfdom accepts but that are not trees (urdf_topology.h).
+    { "U86", "a fixed joint whose parent and child are the same link", Expect::Refused, "SceneDescriptionError",
+      "parent and child are the same link 'c'",
+      load(robot("<link name=\"b\">" + I + "</link>" + floatingJoint("b") + "<link name=\"c\"/>" +
+                 "<joint name=\"c_j\" type=\"fixed\"><parent link=\"c\"/><child link=\"c\"/></joint>")) },
+    { "U87", "two links, each the other's parent, beside the root", Expect::Refused, "SceneDescriptionError",
+      "form a cycle",
+      load(robot("<link name=\"b\">" + I + "</link>" + floatingJoint("b") + "<link name=\"c\">" + I +
+                 "</link><link name=\"d\">" + I + "</link>" + joint("fixed", "d", "c") + joint("fixed", "c", "d"))) },
+    { "U88", "a link with two parent joints, in a cycle (world -> a -> b -> a)", Expect::Refused,
+      "SceneDescriptionError", "is the child of two joints",
+      load(robot("<link name=\"a\">" + I + "</link><link name=\"b\">" + I + "</link>" + floatingJoint("a") +
+                 joint("fixed", "a", "b") + "<joint name=\"back\" type=\"fixed\"><parent link=\"b\"/>" +
+                 "<child link=\"a\"/></joint>")) },
   };
   rows.insert(rows.end(), more.begin(), more.end());
   return rows;
