@@ -22,7 +22,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "diff_rigid_body/rigid_body.h"
+#include "diff_rigid_body/mass_property_checks.h"
 #include "diff_rigid_body/triangle_mesh.h"
 
 namespace diff_rigid_body

@@ -1,20 +1,12 @@
-// The rigid-body model: mass, inertia, COM offset and body-frame vertices.
-//
-// Frames:
-//   link frame  the URDF link frame of the body.
-//   body frame  origin at the COM, axes of the link frame. A link-frame point
-//               x maps to x - com_offset in the body frame.
-// The state q = (phi, theta, psi, tx, ty, tz) gives the RPY angles of the
-// link (= body) axes and the COM position t in the fixed frame, so the link
-// origin sits at t - R com_offset.
+// Mass properties of a link or a composite of links, and the rules that
+// sort what a description gives into undefined (refused) and implausible
+// (loaded with a warning); interface.md, "Inertia from real URDFs".
 #pragma once
 
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
-
-#include "diff_rigid_body/types.h"
 
 namespace diff_rigid_body
 {
@@ -46,15 +38,5 @@ std::vector<std::string> checkMassProperties(const std::string& where, double ma
 /// the first implausible finding. Accepts only mass > 0 with a finite,
 /// symmetric, positive-definite tensor that satisfies the triangle inequality.
 void validateMassProperties(const std::string& where, double mass, const Eigen::Matrix3d& inertia);
-
-/// One free rigid body of the scene.
-struct RigidBody
-{
-  std::string name;                                          ///< body link name
-  double mass = 0.0;                                         ///< [kg]
-  Eigen::Matrix3d inertia_body = Eigen::Matrix3d::Identity();  ///< about the COM, body axes [kg m^2]
-  Eigen::Vector3d com_offset = Eigen::Vector3d::Zero();      ///< COM in the link frame [m]
-  Matrix3X<double> vertices;                                 ///< body frame, one per column [m]
-};
 
 }  // namespace diff_rigid_body

@@ -46,6 +46,18 @@ struct RpyTrig
   explicit RpyTrig(const Eigen::MatrixBase<Derived>& q) : RpyTrig(q[PHI], q[THETA], q[PSI])
   {
   }
+
+  /// From sines and cosines computed elsewhere (e.g. in one vectorised call),
+  /// each array in the order (phi, theta, psi).
+  RpyTrig(const Scalar* sines, const Scalar* cosines)
+    : s_phi(sines[0])
+    , c_phi(cosines[0])
+    , s_theta(sines[1])
+    , c_theta(cosines[1])
+    , s_psi(sines[2])
+    , c_psi(cosines[2])
+  {
+  }
 };
 
 /// R = Rz(psi) Ry(theta) Rx(phi), the rotation from the body axes to the fixed frame.

@@ -14,9 +14,9 @@
 #include <utility>
 #include <vector>
 
-#include "diff_rigid_body/articulated_kinematics.h"
+#include "diff_rigid_body/body_workspace.h"
 #include "diff_rigid_body/urdf_scene.h"
-#include "diff_rigid_body/vertex_columns.h"
+#include "diff_rigid_body/vertex_jacobians.h"
 
 namespace diff_rigid_body
 {
@@ -29,11 +29,10 @@ struct RequestLimits
   /// Jacobians of 2^22 vertices of a free body take 640 MiB). Also the most
   /// configurations.
   static constexpr std::size_t kMaxVertices = std::size_t(1) << 22;
-  /// Doubles that a vertex request on an articulated body may need: its
-  /// answer, 3 (1 + d) per vertex and configuration, and its motion
-  /// matrices, 6 d per segment. The free body's 21 per vertex times
-  /// kMaxVertices (640 MiB).
-  static constexpr std::size_t kMaxArticulatedDoubles = 21 * kMaxVertices;
+  /// Doubles in the answer of one vertex request on a body of any dof:
+  /// 3 (1 + written columns) per vertex and configuration; the free body's
+  /// 21 per vertex times kMaxVertices (640 MiB).
+  static constexpr std::size_t kMaxVertexAnswerDoubles = 21 * kMaxVertices;
   /// Mass matrices (configurations x bodies) of 6-dof bodies in one
   /// get_mass_matrix request; with derivatives each costs 252 doubles (2 KiB).
   static constexpr std::size_t kMaxMassMatrices = 1000000;
@@ -46,16 +45,16 @@ struct RequestLimits
   static constexpr std::size_t kMaxStates = 100000;
 };
 
-/// One x per body, in scene order, len = scene.bodies[i].dofs(): a free
-/// body's q = (phi, theta, psi, tx, ty, tz), an articulated body's
-/// coordinates (articulated_body.h).
+/// One x per body, in scene order, len = scene.bodies[i].coordinates: a free
+/// object's q = (phi, theta, psi, tx, ty, tz), a tree's coordinates
+/// (body_model.h).
 using SceneState = std::vector<Eigen::VectorXd>;
 
-/// Named state of one body, as requests carry it (x, dofs() values).
+/// Named state of one body, as requests carry it: its x (d values).
 struct NamedState
 {
   std::string name;
-  Eigen::VectorXd q = Eigen::VectorXd::Zero(6);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(6);
 };
 
 /// Matrices in configuration-major order, then the listed bodies' order:
@@ -71,17 +70,54 @@ struct MassMatrixAnswer
   std::vector<double> cos_theta;
 };
 
+/// ~inverse_dynamics' answer, laid out as MassMatrixAnswer: per configuration
+/// k and listed body i, vectors of d_i values at k D + (sum of the d before
+/// i) and matrices of d_i^2 (row-major) at k sum(d^2) + (sum of the d^2 before i).
+struct InverseDynamicsAnswer
+{
+  std::vector<std::string> bodies;
+  std::vector<std::uint32_t> dofs;
+  std::vector<double> tau;                ///< M x'' + c + g
+  std::vector<double> velocity_terms;     ///< c = C x'
+  std::vector<double> gravity_terms;      ///< g
+  std::vector<double> coriolis_matrices;  ///< C, when asked
+  std::vector<double> dtau_dq;            ///< when asked
+  std::vector<double> dtau_dqdot;         ///< when asked (= 2 C)
+  std::vector<double> cos_theta;          ///< per matrix slot, as MassMatrixAnswer
+};
+
+/// ~forward_dynamics' answer, laid out as InverseDynamicsAnswer.
+struct ForwardDynamicsAnswer
+{
+  std::vector<std::string> bodies;
+  std::vector<std::uint32_t> dofs;
+  std::vector<double> qddot;         ///< M^-1 (tau - c - g)
+  std::vector<double> dqddot_dq;     ///< when asked
+  std::vector<double> dqddot_dqdot;  ///< when asked
+  std::vector<double> dqddot_dtau;   ///< M^-1, when asked
+  std::vector<double> cos_theta;
+};
+
+/// Standard gravity in the fixed frame, -9.81 m/s^2 along z (~gravity's default).
+inline Eigen::Vector3d standardGravity()
+{
+  return Eigen::Vector3d(0.0, 0.0, -9.81);
+}
+
 class SceneQueries
 {
 public:
-  explicit SceneQueries(Scene scene);
+  /// `gravity`: gamma in the fixed frame [m/s^2] (~gravity), for the dynamics.
+  explicit SceneQueries(Scene scene, const Eigen::Vector3d& gravity = standardGravity());
+
+  const Eigen::Vector3d& gravity() const { return gravity_; }
 
   const Scene& scene() const { return scene_; }
   std::size_t bodyCount() const { return scene_.bodies.size(); }
-  const RigidBody& body(std::size_t index) const { return scene_.bodies[index].body; }
+  const BodyModel& body(std::size_t index) const { return scene_.bodies[index]; }
 
-  /// len(x) of body `index`: 6 for a free body.
-  std::size_t dofs(std::size_t index) const { return scene_.bodies[index].dofs(); }
+  /// d = len(x) of body `index`: 6 for a free object.
+  std::size_t dofs(std::size_t index) const { return scene_.bodies[index].coordinates; }
 
   /// The URDF initial state of every body.
   SceneState initialState() const;
@@ -89,62 +125,67 @@ public:
   /// Index of body `name`; throws naming `field` and the known bodies.
   std::size_t bodyIndex(const std::string& name, const std::string& field) const;
 
-  /// Indices of `names` (empty = all bodies, in scene order).
-  std::vector<std::size_t> bodyIndices(const std::vector<std::string>& names, const std::string& field) const;
+  /// Indices of `names` (empty = all bodies, in scene order), into `indices`
+  /// (its buffer reused), or returned.
+  void bodyIndices(const std::vector<std::string>& names, const char* field, std::vector<std::size_t>& indices) const;
+  std::vector<std::size_t> bodyIndices(const std::vector<std::string>& names, const char* field) const;
 
   /// The state after applying `updates` to `current`, all or nothing: an
-  /// unknown or repeated name, a q whose length is not the body's dofs, or a
-  /// non-finite value rejects the whole request. q is stored bit for bit (no
-  /// angle wrapping).
+  /// unknown or repeated name, an x whose length is not the body's d, a
+  /// non-finite value, or link poses that overflow rejects the whole
+  /// request. x is stored bit for bit (no angle wrapping).
   SceneState applyStates(const SceneState& current, const std::vector<NamedState>& updates) const;
 
   /// The state after a sensor_msgs/JointState message: each named
-  /// independent joint of an articulated body is set (x index
-  /// rootCoordinates() + k for joint_names[k]; a repeated name: the last
-  /// wins). Names of mimic joints are ignored; any other name is appended to
-  /// `unknown_names` and ignored. All or nothing: names and positions of
-  /// different lengths, more than RequestLimits::kMaxStates names, or a
-  /// non-finite position (of any joint) throws InvalidArgumentError and
-  /// changes nothing.
+  /// independent joint is set (x index rootCoordinates() + k for
+  /// joint_names[k]; a repeated name: the last wins). Names of mimic joints
+  /// are ignored; any other name is appended to `unknown_names` and ignored.
+  /// All or nothing: names and positions of different lengths, more than
+  /// RequestLimits::kMaxStates names, a non-finite position (of any joint)
+  /// or overflowing link poses throws InvalidArgumentError and changes nothing.
   SceneState applyJointPositions(const SceneState& current, const std::vector<std::string>& names,
                                  const std::vector<double>& positions, std::vector<std::string>& unknown_names) const;
 
   /// States of `names` (empty = all).
   std::vector<NamedState> getStates(const SceneState& current, const std::vector<std::string>& names) const;
 
+  /// Pose in the fixed frame of every link of body `index` at x, in
+  /// body(index).links order (tf): linkPoses of kinematics.h.
+  void linkPoses(std::size_t index, const Eigen::VectorXd& x, std::vector<Eigen::Isometry3d>& poses) const;
+
   /// M(x), and dM/dx when `derivatives`, for the bodies `names` (empty = all)
   /// at K configurations given in `q` (each the concatenation of the listed
-  /// bodies' x: K D values, D = sum of their dofs), or at `current` when `q`
-  /// is empty. At most RequestLimits::kMaxMassMatrixDoubles answer doubles
-  /// (...WithDerivatives when `derivatives`).
+  /// bodies' x: K D values, D = sum of their d), or at `current` when `q` is
+  /// empty. At most RequestLimits::kMaxMassMatrixDoubles answer doubles
+  /// (...WithDerivatives when `derivatives`). `answer` is overwritten (its
+  /// buffers reused); on refusal it holds no answer.
+  void massMatrices(const SceneState& current, const std::vector<std::string>& names, const std::vector<double>& q,
+                    bool derivatives, MassMatrixAnswer& answer) const;
   MassMatrixAnswer massMatrices(const SceneState& current, const std::vector<std::string>& names,
                                 const std::vector<double>& q, bool derivatives) const;
 
   /// Positions (3 per vertex, fixed frame) and Jacobians dp/dx (3 d per
-  /// vertex, 3 x d row-major, d = the body's dofs; 18 for a free body) of
-  /// the N selected vertices (empty = all), at the current state when `q` is
-  /// empty, else at each of the K configurations in `q` (d K values):
-  /// K x N x 3 positions and K x N x 3d values of J, configuration-major,
-  /// each configuration computed as a call with its d values alone would
-  /// (same bits). K x N is at most RequestLimits::kMaxVertices. A
-  /// configuration whose positions or J would not be finite is refused.
-  /// Outputs are resized here, and untouched on refusal.
+  /// vertex, 3 x d row-major; 18 for a free object) of the N selected
+  /// vertices (empty = all), at the current state when `q` is empty, else at
+  /// each of the K configurations in `q` (d K values): K x N x 3 positions
+  /// and K x N x 3d values of J, configuration-major, each configuration
+  /// computed as a call with its d values alone would (same bits). K x N is
+  /// at most RequestLimits::kMaxVertices, and the answer at most
+  /// kMaxVertexAnswerDoubles. A configuration whose outputs could overflow
+  /// is refused (vertexOutputBound). Outputs are resized here, and untouched
+  /// on refusal.
   void vertexJacobians(const SceneState& current, const std::string& body, const std::vector<std::uint32_t>& vertices,
                        const std::vector<double>& q, std::vector<double>& positions,
                        std::vector<double>& jacobians) const;
 
   /// The reduced transport of vertexJacobians (~get_vertex_jacobians_compact):
   /// positions (3 per vertex) and, unless `positions_only`, J without the
-  /// columns that are always I3, stored as Out: double, or float for the
-  /// float32 transport. compactColumns(body) values per row:
-  ///   free body: Jr = dp/d(phi, theta, psi), 9 per vertex (3x3 row-major);
-  ///   articulated, floating root: every column but x[3..5], 3 (d - 3) per vertex;
-  ///   articulated, fixed base: every column, 3 d per vertex.
-  /// The checks and messages of vertexJacobians; a request whose outputs
-  /// would overflow Out is refused before anything is written. K
-  /// configurations in `q` as vertexJacobians (configuration-major).
-  /// Outputs are resized here (rotation_jacobians to 0 when `positions_only`).
-  /// Instantiated for Out = double and float.
+  /// columns that are always I3 (JacobianColumns::compact), stored as Out:
+  /// double, or float for the float32 transport. compactColumns(body) values
+  /// per row: 3 for a free object (dp/d(phi, theta, psi)), d - 3 for a tree
+  /// with a free root, d for a fixed base. The checks and messages of
+  /// vertexJacobians, with max(Out) as the overflow limit. Instantiated for
+  /// Out = double and float.
   template <typename Out>
   void vertexRotationJacobians(const SceneState& current, const std::string& body,
                                const std::vector<std::uint32_t>& vertices, const std::vector<double>& q,
@@ -152,73 +193,95 @@ public:
                                std::vector<Out>& rotation_jacobians) const;
 
   /// dL/dx = sum_i J_i^T g_i at each of the K configurations of `q` (d K
-  /// values, d = the body's dofs; empty = the current state, K = 1), for
-  /// gradients g given as K x N x 3 values (configuration-major: 3 per
-  /// selected vertex for each configuration). Returns K x d values,
-  /// configuration k's as a call with its x and gradients alone would give
-  /// them (same bits).
+  /// values; empty = the current state, K = 1), for gradients g given as
+  /// K x N x 3 values (configuration-major: 3 per selected vertex for each
+  /// configuration), into `gradient` (K x d values, configuration k's as a
+  /// call with its x and gradients alone would give them, same bits; its
+  /// buffer is reused, and it is left empty on refusal).
+  void backpropConfigurations(const SceneState& current, const std::string& body,
+                              const std::vector<std::uint32_t>& vertices, const std::vector<double>& gradients,
+                              const std::vector<double>& q, std::vector<double>& gradient) const;
   std::vector<double> backpropConfigurations(const SceneState& current, const std::string& body,
                                              const std::vector<std::uint32_t>& vertices,
                                              const std::vector<double>& gradients,
                                              const std::vector<double>& q) const;
 
   /// Columns per row of body `index`'s compact Jacobian (see vertexRotationJacobians).
-  std::size_t compactColumns(std::size_t index) const;
+  std::size_t compactColumns(std::size_t index) const { return compact_columns_[index].width; }
 
   /// backpropConfigurations for one configuration (`q` empty or d values).
   Eigen::VectorXd backprop(const SceneState& current, const std::string& body,
                            const std::vector<std::uint32_t>& vertices, const std::vector<double>& gradients,
                            const std::vector<double>& q) const;
 
+  /// Inverse dynamics of the bodies `names` (empty = all) at K
+  /// configurations (q: K D values, D the sum of their d; empty = the
+  /// current state, K = 1), with qdot and qddot of q's length or empty
+  /// (zeros): tau, c and g, and with `coriolis` C, with `derivatives`
+  /// dtau/dx and dtau/dx' (rnea.h, rnea_derivatives.h). Defined everywhere,
+  /// gimbal lock included. Refused, before anything is computed: unknown
+  /// bodies, lengths that do not match, non-finite values, answers over
+  /// RequestLimits' budgets; after: a result that is not finite.
+  void inverseDynamics(const SceneState& current, const std::vector<std::string>& names,
+                       const std::vector<double>& q, const std::vector<double>& qdot,
+                       const std::vector<double>& qddot, bool coriolis, bool derivatives,
+                       InverseDynamicsAnswer& answer) const;
+
+  /// Forward dynamics x'' (forward_dynamics.h), with `derivatives`
+  /// dx''/dx, dx''/dx' and M^-1, laid out and checked as inverseDynamics
+  /// (tau in place of qddot). A configuration where M is singular refuses the
+  /// whole request, naming the body, the configuration and why.
+  void forwardDynamics(const SceneState& current, const std::vector<std::string>& names,
+                       const std::vector<double>& q, const std::vector<double>& qdot, const std::vector<double>& tau,
+                       bool derivatives, ForwardDynamicsAnswer& answer) const;
+
+  /// This thread's workspace for body `index`, made on first use and kept
+  /// for the thread's next calls on this SceneQueries: queries allocate
+  /// nothing for their computation in steady state, and threads share none.
+  BodyWorkspace<double>& workspace(std::size_t index) const;
+
 private:
   /// K for a request's `q` (empty = 1, else its size / d), checked against
   /// its size (a multiple of d = dofs(index)), the vertex limit for K x
-  /// `vertex_count` and, for an articulated body, its work limit.
-  std::size_t configurationCount(const std::vector<double>& q, std::size_t index, std::size_t vertex_count) const;
-  /// Refuses a vertex request on articulated body `index` whose answer
-  /// (3 (1 + d) doubles per vertex and configuration) or per-segment motion
-  /// matrices (6 d per segment) exceed RequestLimits::kMaxArticulatedDoubles.
-  void checkArticulatedWork(std::size_t index, std::size_t configurations, std::size_t vertex_count) const;
+  /// `vertex_count`, and the answer limit for `width` columns.
+  std::size_t configurationCount(const std::vector<double>& q, std::size_t index, std::size_t vertex_count,
+                                 std::size_t width) const;
   /// The d values of configuration k of body `index`: q + d k, or the current state when `q` is empty.
   const double* configurationQ(const SceneState& current, std::size_t index, const std::vector<double>& q,
                                std::size_t k) const;
+  /// Checks every index of `vertices` against body `index`.
+  std::size_t checkVertices(std::size_t index, const std::vector<std::uint32_t>& vertices) const;
   /// Refuses, naming the configuration when there are several, a
-  /// configuration whose bound |t|_inf + inflation max_i |p0_i| on every
-  /// output exceeds `limit` ("... would overflow<suffix>").
-  void checkPositionsFit(const SceneState& current, std::size_t index, const std::vector<double>& q,
-                         std::size_t configurations, double inflation, double limit, const char* suffix) const;
+  /// configuration whose vertexOutputBound exceeds `limit`.
+  void checkOutputsFit(const SceneState& current, std::size_t index, const JacobianColumns& columns,
+                       const std::vector<std::uint32_t>& vertices, const std::vector<double>& q,
+                       std::size_t configurations, double limit, const char* suffix) const;
+  /// The vertex query behind vertexJacobians and vertexRotationJacobians.
+  template <typename Out>
+  void vertexQuery(const SceneState& current, const std::string& body, const std::vector<std::uint32_t>& vertices,
+                   const std::vector<double>& q, bool compact, bool positions_only, std::vector<Out>& positions,
+                   std::vector<Out>& jacobians) const;
   /// Refuses a get_mass_matrix answer over the budget of doubles.
   void checkMassMatrixBudget(std::size_t configurations, std::size_t bodies, std::size_t per_configuration,
                              bool all_free, bool derivatives, std::size_t q_size) const;
-  /// Checks every index of `vertices` against body `index`.
-  std::size_t checkVertices(std::size_t index, const std::vector<std::uint32_t>& vertices) const;
-  /// The articulated pose of configuration k, refused ("... would overflow")
-  /// if a segment frame is not finite.
-  ArticulatedPose<double> checkedPose(const SceneState& current, std::size_t index, const std::vector<double>& q,
-                                      std::size_t configurations, std::size_t k) const;
-  /// Positions and the J `columns` (empty = all) of an articulated body's
-  /// vertices, stored as Out; refused if a value would exceed max(Out).
-  template <typename Out>
-  void articulatedCompact(const SceneState& current, std::size_t index, const std::vector<std::uint32_t>& vertices,
-                          std::size_t count, const std::vector<double>& q, std::size_t configurations,
-                          bool positions_only, const std::vector<int>& columns, std::vector<Out>& positions,
-                          std::vector<Out>& jacobians) const;
 
   Scene scene_;
-  std::vector<double> vertex_radius_;  ///< max_i |p0_i| per body [m]
-  /// Each body's vertices stored by coordinate, for the backprop of all
-  /// vertices (vertex_columns.h; 24 B per vertex).
-  std::vector<VertexColumns<double>> vertex_columns_;
+  Eigen::Vector3d gravity_;
+  /// Per body: every Jacobian column, and the compact transport's.
+  std::vector<JacobianColumns> all_columns_;
+  std::vector<JacobianColumns> compact_columns_;
   /// Body name -> index: O(1) lookups, so that a request of 10^5 states on a
   /// scene of 10^5 bodies is not quadratic.
   std::unordered_map<std::string, std::size_t> body_index_;
   /// Independent joint name -> (body, x index), and the names of mimic joints.
   std::unordered_map<std::string, std::pair<std::size_t, std::size_t>> joint_index_;
   std::unordered_set<std::string> mimic_joints_;
+  /// Tells this object's workspaces from another's in a thread's cache (never reused).
+  std::uint64_t id_;
 };
 
 /// Throws InvalidArgumentError("<field>[<i>]: not finite (...)") for the first
 /// non-finite value.
-void requireFinite(const double* values, std::size_t count, const std::string& field);
+void requireFinite(const double* values, std::size_t count, const char* field);
 
 }  // namespace diff_rigid_body

@@ -7,9 +7,14 @@
 
 #include <Eigen/Core>
 
+#include <diff_rigid_body/Backprop.h>
+#include <diff_rigid_body/ForwardDynamics.h>
 #include <diff_rigid_body/GetBodies.h>
 #include <diff_rigid_body/GetMassMatrix.h>
+#include <diff_rigid_body/GetVertexJacobians.h>
+#include <diff_rigid_body/InverseDynamics.h>
 
+#include "diff_rigid_body_ros/client_arrays.h"
 #include "diff_rigid_body_ros/client_types.h"
 
 namespace diff_rigid_body_ros
@@ -82,6 +87,89 @@ inline MassMatrices toMassMatrices(const diff_rigid_body::GetMassMatrix::Respons
       out.dM.back().push_back(Eigen::Map<const RowMajorMatrix>(r.derivatives.data() + at_derivatives, d, d));
   }
   out.cos_theta = r.cos_theta;
+  return out;
+}
+
+/// A dynamics response field cut per entry m = k n + i (body i = m % n): d_i values (vectors) or
+/// d_i^2 row-major values (matrices) each. Empty when the field is (not asked for).
+inline std::vector<Eigen::VectorXd> perEntryVectors(const std::vector<double>& values,
+                                                    const std::vector<std::uint32_t>& dofs, std::size_t entries)
+{
+  std::vector<Eigen::VectorXd> out;
+  for (std::size_t m = 0, at = 0; m < entries && !values.empty(); at += dofs[m % dofs.size()], ++m)
+    out.push_back(Eigen::Map<const Eigen::VectorXd>(values.data() + at, dofs[m % dofs.size()]));
+  return out;
+}
+inline std::vector<Eigen::MatrixXd> perEntryMatrices(const std::vector<double>& values,
+                                                     const std::vector<std::uint32_t>& dofs, std::size_t entries)
+{
+  using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  std::vector<Eigen::MatrixXd> out;
+  for (std::size_t m = 0, at = 0; m < entries && !values.empty(); ++m)
+  {
+    const Eigen::Index d = dofs[m % dofs.size()];
+    out.push_back(Eigen::Map<const RowMajorMatrix>(values.data() + at, d, d));
+    at += d * d;
+  }
+  return out;
+}
+
+/// inverse_dynamics: one entry per body and configuration (cos_theta has one value per entry).
+inline InverseDynamicsResult toInverseDynamics(const diff_rigid_body::InverseDynamics::Response& r)
+{
+  InverseDynamicsResult out;
+  out.bodies = r.bodies;
+  out.dofs = r.dofs;
+  const std::size_t entries = r.cos_theta.size();
+  out.configurations = out.bodies.empty() ? 0 : entries / out.bodies.size();
+  out.tau = perEntryVectors(r.tau, r.dofs, entries);
+  out.velocity_terms = perEntryVectors(r.velocity_terms, r.dofs, entries);
+  out.gravity_terms = perEntryVectors(r.gravity_terms, r.dofs, entries);
+  out.coriolis_matrices = perEntryMatrices(r.coriolis_matrices, r.dofs, entries);
+  out.dtau_dq = perEntryMatrices(r.dtau_dq, r.dofs, entries);
+  out.dtau_dqdot = perEntryMatrices(r.dtau_dqdot, r.dofs, entries);
+  out.cos_theta = r.cos_theta;
+  return out;
+}
+
+/// forward_dynamics, as toInverseDynamics.
+inline ForwardDynamicsResult toForwardDynamics(const diff_rigid_body::ForwardDynamics::Response& r)
+{
+  ForwardDynamicsResult out;
+  out.bodies = r.bodies;
+  out.dofs = r.dofs;
+  const std::size_t entries = r.cos_theta.size();
+  out.configurations = out.bodies.empty() ? 0 : entries / out.bodies.size();
+  out.qddot = perEntryVectors(r.qddot, r.dofs, entries);
+  out.dqddot_dq = perEntryMatrices(r.dqddot_dq, r.dofs, entries);
+  out.dqddot_dqdot = perEntryMatrices(r.dqddot_dqdot, r.dofs, entries);
+  out.dqddot_dtau = perEntryMatrices(r.dqddot_dtau, r.dofs, entries);
+  out.cos_theta = r.cos_theta;
+  return out;
+}
+
+/// get_vertex_jacobians of K configurations: one block of positions and J per configuration.
+inline std::vector<VertexJacobians> toVertexJacobians(const diff_rigid_body::GetVertexJacobians::Response& r,
+                                                      std::size_t K)
+{
+  const Eigen::Index n = detail::vertexCount(r.positions.size(), K);
+  const Eigen::Index d = n ? static_cast<Eigen::Index>(r.jacobians.size() / (3 * n * K)) : 0;
+  std::vector<VertexJacobians> out(K);
+  for (std::size_t k = 0; k < K; ++k)
+  {
+    out[k].positions = Eigen::Map<const Eigen::Matrix3Xd>(r.positions.data() + 3 * n * k, 3, n);
+    out[k].J = Eigen::Map<const StackedJacobians>(r.jacobians.data() + 3 * n * d * k, 3 * n, d);
+  }
+  return out;
+}
+
+/// backprop of K configurations: dL/dx (d values) per configuration.
+inline std::vector<Eigen::VectorXd> toGradients(const diff_rigid_body::Backprop::Response& r, std::size_t K)
+{
+  const Eigen::Index d = K ? static_cast<Eigen::Index>(r.gradient.size() / K) : 0;
+  std::vector<Eigen::VectorXd> out(K);
+  for (std::size_t k = 0; k < K; ++k)
+    out[k] = Eigen::Map<const Eigen::VectorXd>(r.gradient.data() + d * k, d);
   return out;
 }
 

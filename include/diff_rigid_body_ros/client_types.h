@@ -88,6 +88,39 @@ struct MassMatrices
   const Eigen::MatrixXd& at(std::size_t k, std::size_t i) const { return M.at(k * bodies.size() + i); }
 };
 
+/// inverse_dynamics: K configurations of n bodies; entry m = k*n + i is body i at configuration
+/// k (index(k, i)): d_i values per vector, d_i x d_i matrices (row = tau component).
+struct InverseDynamicsResult
+{
+  std::vector<std::string> bodies;                 ///< the n bodies, in answer order
+  std::vector<std::uint32_t> dofs;                 ///< d_i per body
+  std::size_t configurations = 0;                  ///< K
+  std::vector<Eigen::VectorXd> tau;                ///< M x'' + c + g [N m, N]
+  std::vector<Eigen::VectorXd> velocity_terms;     ///< c = C x'
+  std::vector<Eigen::VectorXd> gravity_terms;      ///< g = dV/dx (~gravity)
+  std::vector<Eigen::MatrixXd> coriolis_matrices;  ///< C, when asked (else empty)
+  std::vector<Eigen::MatrixXd> dtau_dq;            ///< dtau/dx, with derivatives (else empty)
+  std::vector<Eigen::MatrixXd> dtau_dqdot;         ///< dtau/dx' = 2 C, with derivatives (else empty)
+  std::vector<double> cos_theta;                   ///< gimbal-lock diagnostic per entry (1 for a fixed base)
+
+  std::size_t index(std::size_t k, std::size_t i) const { return k * bodies.size() + i; }
+};
+
+/// forward_dynamics, laid out as InverseDynamicsResult (row = x'' component).
+struct ForwardDynamicsResult
+{
+  std::vector<std::string> bodies;
+  std::vector<std::uint32_t> dofs;
+  std::size_t configurations = 0;
+  std::vector<Eigen::VectorXd> qddot;         ///< x'' = M^-1 (tau - c - g) [rad/s^2, m/s^2]
+  std::vector<Eigen::MatrixXd> dqddot_dq;     ///< dx''/dx, with derivatives (else empty)
+  std::vector<Eigen::MatrixXd> dqddot_dqdot;  ///< dx''/dx', with derivatives (else empty)
+  std::vector<Eigen::MatrixXd> dqddot_dtau;   ///< dx''/dtau = M^-1, with derivatives (else empty)
+  std::vector<double> cos_theta;
+
+  std::size_t index(std::size_t k, std::size_t i) const { return k * bodies.size() + i; }
+};
+
 /// get_vertex_jacobians.
 struct VertexJacobians
 {

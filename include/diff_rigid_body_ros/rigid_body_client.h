@@ -4,8 +4,9 @@
 // reopened once if it drops, e.g. when the node restarts). A service that
 // answers success=false throws diff_rigid_body_ros::ServiceError carrying the
 // node's message; a service that cannot be reached throws
-// diff_rigid_body_ros::ConnectionError. Not thread-safe (persistent clients
-// are not): use one RigidBodyClient per thread.
+// diff_rigid_body_ros::ConnectionError (at once when a dropped connection is
+// not to be reopened: setReconnect(false), as RigidBodyPool does). Not
+// thread-safe (persistent clients are not): use one RigidBodyClient per thread.
 //
 // This is the ROS layer: it lives outside include/diff_rigid_body/, the
 // ROS-free core.
@@ -17,6 +18,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -28,13 +30,16 @@
 
 #include <diff_rigid_body/Backprop.h>
 #include <diff_rigid_body/BodyState.h>
+#include <diff_rigid_body/ForwardDynamics.h>
 #include <diff_rigid_body/GetBodies.h>
 #include <diff_rigid_body/GetMassMatrix.h>
 #include <diff_rigid_body/GetState.h>
 #include <diff_rigid_body/GetVertexJacobians.h>
 #include <diff_rigid_body/GetVertexJacobiansCompact.h>
+#include <diff_rigid_body/InverseDynamics.h>
 #include <diff_rigid_body/SetState.h>
 
+#include "diff_rigid_body_ros/client_arrays.h"
 #include "diff_rigid_body_ros/client_responses.h"
 
 namespace diff_rigid_body_ros
@@ -54,7 +59,7 @@ public:
   Bodies bodies()
   {
     diff_rigid_body::GetBodies srv;
-    call(get_bodies_, "get_bodies", srv);
+    call("get_bodies", srv);
     return toBodies(srv.response);
   }
 
@@ -63,7 +68,7 @@ public:
   {
     diff_rigid_body::GetState srv;
     srv.request.bodies = bodies;
-    call(get_state_, "get_state", srv);
+    call("get_state", srv);
     BodyStates out;
     for (const auto& state : srv.response.states)
       out.emplace_back(state.name, Eigen::Map<const Eigen::VectorXd>(state.q.data(), state.q.size()));
@@ -94,7 +99,7 @@ public:
     srv.request.bodies = bodies;
     srv.request.q = q;
     srv.request.derivatives = derivatives;
-    call(get_mass_matrix_, "get_mass_matrix", srv);
+    call("get_mass_matrix", srv);
     return toMassMatrices(srv.response, derivatives);
   }
 
@@ -102,7 +107,62 @@ public:
   template <typename Derived>
   Eigen::MatrixXd massMatrix(const std::string& body, const Eigen::MatrixBase<Derived>& x)
   {
-    return massMatrices({ body }, values(x)).M.at(0);
+    return massMatrices({ body }, detail::values(x)).M.at(0);
+  }
+
+  /// tau = M(x) x'' + c(x, x') + g(x) [N m, N] of `bodies` (empty = all) at K configurations:
+  /// `q` as for massMatrices (empty = the current state, K = 1), `qdot` [rad/s, m/s] and `qddot`
+  /// [rad/s^2, m/s^2] of q's length (for an empty q: the bodies' D values) or empty (zeros).
+  /// `coriolis_matrices` adds C, `derivatives` dtau/dx and dtau/dx'. Defined at gimbal lock too.
+  InverseDynamicsResult inverseDynamics(const std::vector<double>& q = {}, const std::vector<double>& qdot = {},
+                                        const std::vector<double>& qddot = {},
+                                        const std::vector<std::string>& bodies = {}, bool coriolis_matrices = false,
+                                        bool derivatives = false)
+  {
+    diff_rigid_body::InverseDynamics srv;
+    srv.request.bodies = bodies;
+    srv.request.q = q;
+    srv.request.qdot = qdot;
+    srv.request.qddot = qddot;
+    srv.request.coriolis_matrices = coriolis_matrices;
+    srv.request.derivatives = derivatives;
+    call("inverse_dynamics", srv);
+    return toInverseDynamics(srv.response);
+  }
+  /// One body at one configuration (any Eigen vectors of its d coordinates).
+  template <typename Q, typename Qdot, typename Qddot>
+  InverseDynamicsResult inverseDynamics(const std::string& body, const Eigen::MatrixBase<Q>& x,
+                                        const Eigen::MatrixBase<Qdot>& xdot, const Eigen::MatrixBase<Qddot>& xddot,
+                                        bool derivatives = false)
+  {
+    return inverseDynamics(detail::values(x), detail::values(xdot), detail::values(xddot), { body }, false,
+                           derivatives);
+  }
+
+  /// x'' = M(x)^-1 (tau - c(x, x') - g(x)) [rad/s^2, m/s^2] of `bodies` (empty = all), laid out as
+  /// inverseDynamics (`tau` [N m, N] in place of qddot); `derivatives` adds dx''/dx, dx''/dx' and
+  /// dx''/dtau = M^-1. A configuration where M is singular (gimbal lock, a coordinate that moves
+  /// no mass) throws ServiceError naming the body and the configuration.
+  ForwardDynamicsResult forwardDynamics(const std::vector<double>& q = {}, const std::vector<double>& qdot = {},
+                                        const std::vector<double>& tau = {},
+                                        const std::vector<std::string>& bodies = {}, bool derivatives = false)
+  {
+    diff_rigid_body::ForwardDynamics srv;
+    srv.request.bodies = bodies;
+    srv.request.q = q;
+    srv.request.qdot = qdot;
+    srv.request.tau = tau;
+    srv.request.derivatives = derivatives;
+    call("forward_dynamics", srv);
+    return toForwardDynamics(srv.response);
+  }
+  /// One body at one configuration (any Eigen vectors of its d coordinates).
+  template <typename Q, typename Qdot, typename Tau>
+  ForwardDynamicsResult forwardDynamics(const std::string& body, const Eigen::MatrixBase<Q>& x,
+                                        const Eigen::MatrixBase<Qdot>& xdot, const Eigen::MatrixBase<Tau>& tau,
+                                        bool derivatives = false)
+  {
+    return forwardDynamics(detail::values(x), detail::values(xdot), detail::values(tau), { body }, derivatives);
   }
 
   /// Positions and J = dp/dx of `body`'s `vertices` (empty = all) at `q`
@@ -110,13 +170,13 @@ public:
   VertexJacobians vertexJacobians(const std::string& body, const Vector6d* q = nullptr,
                                   const std::vector<std::uint32_t>& vertices = {})
   {
-    return requestVertexJacobians(body, vertices, optionalQ(q), 1).front();
+    return requestVertexJacobians(body, vertices, detail::optionalQ(q), 1).front();
   }
   template <typename Derived>
   VertexJacobians vertexJacobians(const std::string& body, const Eigen::MatrixBase<Derived>& x,
                                   const std::vector<std::uint32_t>& vertices = {})
   {
-    return requestVertexJacobians(body, vertices, values(x), 1).front();
+    return requestVertexJacobians(body, vertices, detail::values(x), 1).front();
   }
   /// K configurations in one call: positions and J of `body`'s `vertices`
   /// (empty = all) at each x of `qs`, block k for qs[k] (the same bits as a
@@ -124,12 +184,12 @@ public:
   std::vector<VertexJacobians> vertexJacobians(const std::string& body, const std::vector<Vector6d>& qs,
                                                const std::vector<std::uint32_t>& vertices = {})
   {
-    return requestVertexJacobians(body, vertices, flatten(qs), qs.size());
+    return requestVertexJacobians(body, vertices, detail::flatten(qs), qs.size());
   }
   std::vector<VertexJacobians> vertexJacobians(const std::string& body, const std::vector<Eigen::VectorXd>& qs,
                                                const std::vector<std::uint32_t>& vertices = {})
   {
-    return requestVertexJacobians(body, vertices, flatten(qs), qs.size());
+    return requestVertexJacobians(body, vertices, detail::flatten(qs), qs.size());
   }
 
   /// dL/dx (d values) from dL/dp (3 x N, column v for vertex v) of `body`'s
@@ -138,13 +198,13 @@ public:
   Eigen::VectorXd backprop(const std::string& body, const Eigen::Matrix3Xd& gradients, const Vector6d* q = nullptr,
                            const std::vector<std::uint32_t>& vertices = {})
   {
-    return requestBackprop(body, vertices, { &gradients }, optionalQ(q), 1).front();
+    return requestBackprop(body, vertices, { &gradients }, detail::optionalQ(q), 1).front();
   }
   template <typename Derived>
   Eigen::VectorXd backprop(const std::string& body, const Eigen::Matrix3Xd& gradients,
                            const Eigen::MatrixBase<Derived>& x, const std::vector<std::uint32_t>& vertices = {})
   {
-    return requestBackprop(body, vertices, { &gradients }, values(x), 1).front();
+    return requestBackprop(body, vertices, { &gradients }, detail::values(x), 1).front();
   }
   /// K configurations in one call: dL/dx at each x of `qs` from dL_dp[k]
   /// (3 x N, column v for vertex v) at qs[k]; entry k has the same bits as a
@@ -152,14 +212,14 @@ public:
   std::vector<Vector6d> backprop(const std::string& body, const std::vector<Eigen::Matrix3Xd>& dL_dp,
                                  const std::vector<Vector6d>& qs, const std::vector<std::uint32_t>& vertices = {})
   {
-    const std::vector<Eigen::VectorXd> out = batchedBackprop(body, dL_dp, flatten(qs), qs.size(), vertices);
+    const std::vector<Eigen::VectorXd> out = batchedBackprop(body, dL_dp, detail::flatten(qs), qs.size(), vertices);
     return std::vector<Vector6d>(out.begin(), out.end());
   }
   std::vector<Eigen::VectorXd> backprop(const std::string& body, const std::vector<Eigen::Matrix3Xd>& dL_dp,
                                         const std::vector<Eigen::VectorXd>& qs,
                                         const std::vector<std::uint32_t>& vertices = {})
   {
-    return batchedBackprop(body, dL_dp, flatten(qs), qs.size(), vertices);
+    return batchedBackprop(body, dL_dp, detail::flatten(qs), qs.size(), vertices);
   }
 
   /// The reduced transport of vertexJacobians: positions and the columns
@@ -171,14 +231,14 @@ public:
                                                          const std::vector<std::uint32_t>& vertices = {},
                                                          bool positions_only = false)
   {
-    return requestCompact<Scalar>(body, vertices, optionalQ(q), 1, positions_only).front();
+    return requestCompact<Scalar>(body, vertices, detail::optionalQ(q), 1, positions_only).front();
   }
   template <typename Scalar = double, typename Derived>
   VertexRotationJacobians<Scalar> vertexJacobiansCompact(const std::string& body, const Eigen::MatrixBase<Derived>& x,
                                                          const std::vector<std::uint32_t>& vertices = {},
                                                          bool positions_only = false)
   {
-    return requestCompact<Scalar>(body, vertices, values(x), 1, positions_only).front();
+    return requestCompact<Scalar>(body, vertices, detail::values(x), 1, positions_only).front();
   }
   /// K configurations in one call: block k for qs[k], as vertexJacobians.
   template <typename Scalar = double, typename Vector>
@@ -187,10 +247,34 @@ public:
                                                                       const std::vector<std::uint32_t>& vertices = {},
                                                                       bool positions_only = false)
   {
-    return requestCompact<Scalar>(body, vertices, flatten(qs), qs.size(), positions_only);
+    return requestCompact<Scalar>(body, vertices, detail::flatten(qs), qs.size(), positions_only);
   }
 
   const std::string& server() const { return server_; }
+  /// false: a call whose connection drops throws ConnectionError at once instead of reconnecting
+  /// once and retrying (the next call connects again, waiting up to the timeout).
+  void setReconnect(bool reconnect) { reconnect_ = reconnect; }
+
+  /// Calls ~`service` (of the registry, services.h) with `srv` over its persistent connection;
+  /// throws ServiceError on success=false, ConnectionError when the node cannot be reached.
+  template <typename Service>
+  void call(const std::string& service, Service& srv)
+  {
+    ros::ServiceClient& client = connections_[service];
+    if (!client || !client.isValid())
+      connect<Service>(client, service);
+    if (!client.call(srv))
+    {
+      client = ros::ServiceClient();  // dropped: the next call opens a new connection
+      if (!reconnect_)
+        throw ConnectionError("service " + server_ + "/" + service + " failed (connection lost)");
+      connect<Service>(client, service);
+      if (!client.call(srv))
+        throw ConnectionError("service " + server_ + "/" + service + " failed after reconnecting");
+    }
+    if (!srv.response.success)
+      throw ServiceError(server_ + "/" + service, srv.response.message);
+  }
 
 private:
   template <typename Service>
@@ -203,22 +287,6 @@ private:
     client = nh_.serviceClient<Service>(name, /*persistent=*/true);
   }
 
-  /// Calls over the persistent connection; reconnects once if it dropped.
-  template <typename Service>
-  void call(ros::ServiceClient& client, const std::string& service, Service& srv)
-  {
-    if (!client || !client.isValid())
-      connect<Service>(client, service);
-    if (!client.call(srv))
-    {
-      connect<Service>(client, service);
-      if (!client.call(srv))
-        throw ConnectionError("service " + server_ + "/" + service + " failed after reconnecting");
-    }
-    if (!srv.response.success)
-      throw ServiceError(server_ + "/" + service, srv.response.message);
-  }
-
   template <typename Vector>
   void requestSetState(const std::vector<std::pair<std::string, Vector>>& states)
   {
@@ -227,10 +295,10 @@ private:
     {
       diff_rigid_body::BodyState state;
       state.name = named.first;
-      state.q = values(named.second);
+      state.q = detail::values(named.second);
       srv.request.states.push_back(std::move(state));
     }
-    call(set_state_, "set_state", srv);
+    call("set_state", srv);
   }
 
   /// get_vertex_jacobians with `q` holding K configurations (or empty: the current state, K = 1).
@@ -242,17 +310,8 @@ private:
     srv.request.body = body;
     srv.request.vertices = vertices;
     srv.request.q = std::move(q);
-    call(get_vertex_jacobians_, "get_vertex_jacobians", srv);
-    const auto& r = srv.response;
-    const Eigen::Index n = vertexCount(r.positions.size(), K);
-    const Eigen::Index d = n ? static_cast<Eigen::Index>(r.jacobians.size() / (3 * n * K)) : 0;
-    std::vector<VertexJacobians> out(K);
-    for (std::size_t k = 0; k < K; ++k)
-    {
-      out[k].positions = Eigen::Map<const Eigen::Matrix3Xd>(r.positions.data() + 3 * n * k, 3, n);
-      out[k].J = Eigen::Map<const StackedJacobians>(r.jacobians.data() + 3 * n * d * k, 3 * n, d);
-    }
-    return out;
+    call("get_vertex_jacobians", srv);
+    return toVertexJacobians(srv.response, K);
   }
 
   std::vector<Eigen::VectorXd> batchedBackprop(const std::string& body, const std::vector<Eigen::Matrix3Xd>& dL_dp,
@@ -276,16 +335,10 @@ private:
     diff_rigid_body::Backprop srv;
     srv.request.body = body;
     srv.request.vertices = vertices;
-    for (const Eigen::Matrix3Xd* gradients : dL_dp)
-      srv.request.gradients.insert(srv.request.gradients.end(), gradients->data(),
-                                   gradients->data() + gradients->size());
+    srv.request.gradients = detail::flattenGradients(dL_dp);
     srv.request.q = std::move(q);
-    call(backprop_, "backprop", srv);
-    const Eigen::Index d = static_cast<Eigen::Index>(srv.response.gradient.size() / K);
-    std::vector<Eigen::VectorXd> out(K);
-    for (std::size_t k = 0; k < K; ++k)
-      out[k] = Eigen::Map<const Eigen::VectorXd>(srv.response.gradient.data() + d * k, d);
-    return out;
+    call("backprop", srv);
+    return toGradients(srv.response, K);
   }
 
   /// get_vertex_jacobians_compact in Scalar (float: single_precision), K configurations in `q`.
@@ -303,11 +356,11 @@ private:
     srv.request.q = std::move(q);
     srv.request.positions_only = positions_only;
     srv.request.single_precision = std::is_same<Scalar, float>::value;
-    call(get_vertex_jacobians_compact_, "get_vertex_jacobians_compact", srv);
+    call("get_vertex_jacobians_compact", srv);
     const auto& r = srv.response;
-    const std::vector<Scalar>& positions = compactField<Scalar>(r.positions, r.positions_f32);
-    const std::vector<Scalar>& jacobians = compactField<Scalar>(r.rotation_jacobians, r.rotation_jacobians_f32);
-    const Eigen::Index n = vertexCount(positions.size(), K);
+    const std::vector<Scalar>& positions = detail::compactField<Scalar>(r.positions, r.positions_f32);
+    const std::vector<Scalar>& jacobians = detail::compactField<Scalar>(r.rotation_jacobians, r.rotation_jacobians_f32);
+    const Eigen::Index n = detail::vertexCount(positions.size(), K);
     const Eigen::Index rows = positions_only ? 0 : 3 * n;
     const Eigen::Index columns = rows ? static_cast<Eigen::Index>(jacobians.size() / (rows * K)) : 0;
     std::vector<VertexRotationJacobians<Scalar>> out(K);
@@ -320,50 +373,11 @@ private:
     return out;
   }
 
-  /// The values of one configuration x.
-  template <typename Derived>
-  static std::vector<double> values(const Eigen::MatrixBase<Derived>& x)
-  {
-    const Eigen::VectorXd evaluated = x;
-    return std::vector<double>(evaluated.data(), evaluated.data() + evaluated.size());
-  }
-
-  /// A single request's q: empty (the current state) or the 6 values of *q.
-  static std::vector<double> optionalQ(const Vector6d* q) { return q ? values(*q) : std::vector<double>(); }
-
-  /// The values of K configurations, concatenated (K >= 1: an empty q would mean the current state).
-  template <typename Vector>
-  static std::vector<double> flatten(const std::vector<Vector>& qs)
-  {
-    if (qs.empty())
-      throw std::invalid_argument("qs: at least one configuration");
-    std::vector<double> q;
-    for (const Vector& one : qs)
-      q.insert(q.end(), one.data(), one.data() + one.size());
-    return q;
-  }
-
-  /// N from the size of a K x N x 3 positions field.
-  static Eigen::Index vertexCount(std::size_t position_values, std::size_t configurations)
-  {
-    return configurations ? static_cast<Eigen::Index>(position_values / (3 * configurations)) : 0;
-  }
-
-  /// The float64 or the float32 field of a compact response.
-  template <typename Scalar>
-  static const std::vector<Scalar>& compactField(const std::vector<double>& f64, const std::vector<float>& f32)
-  {
-    if constexpr (std::is_same<Scalar, float>::value)
-      return f32;
-    else
-      return f64;
-  }
-
   ros::NodeHandle nh_;
   std::string server_;
   ros::Duration timeout_;
-  ros::ServiceClient get_bodies_, set_state_, get_state_, get_mass_matrix_, get_vertex_jacobians_, backprop_,
-      get_vertex_jacobians_compact_;
+  bool reconnect_ = true;
+  std::map<std::string, ros::ServiceClient> connections_;  ///< service name -> its persistent connection
 };
 
 }  // namespace diff_rigid_body_ros

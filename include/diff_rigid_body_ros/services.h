@@ -19,11 +19,13 @@
 
 #include <diff_rigid_body/Backprop.h>
 #include <diff_rigid_body/Echo.h>
+#include <diff_rigid_body/ForwardDynamics.h>
 #include <diff_rigid_body/GetBodies.h>
 #include <diff_rigid_body/GetMassMatrix.h>
 #include <diff_rigid_body/GetState.h>
 #include <diff_rigid_body/GetVertexJacobians.h>
 #include <diff_rigid_body/GetVertexJacobiansCompact.h>
+#include <diff_rigid_body/InverseDynamics.h>
 #include <diff_rigid_body/Ping.h>
 #include <diff_rigid_body/SetState.h>
 
@@ -37,6 +39,8 @@
   X(get_vertex_jacobians,          GetVertexJacobians,        getVertexJacobians,        vertex_jacobians,         vertexJacobians,        false) \
   X(backprop,                      Backprop,                  backprop,                  backprop,                 backprop,               false) \
   X(get_vertex_jacobians_compact,  GetVertexJacobiansCompact, getVertexJacobiansCompact, vertex_jacobians_compact, vertexJacobiansCompact, false) \
+  X(inverse_dynamics,              InverseDynamics,           inverseDynamics,           inverse_dynamics,         inverseDynamics,        false) \
+  X(forward_dynamics,              ForwardDynamics,           forwardDynamics,           forward_dynamics,         forwardDynamics,        false) \
   X(ping,                          Ping,                      ping,                      none,                     none,                   true)  \
   X(echo,                          Echo,                      echo,                      none,                     none,                   true)
 // clang-format on

@@ -13,7 +13,7 @@
 #include <Eigen/Geometry>
 #include <urdf_model/link.h>
 
-#include "diff_rigid_body/rigid_body.h"
+#include "diff_rigid_body/mass_property_checks.h"
 #include "diff_rigid_body/triangle_mesh.h"
 #include "diff_rigid_body/urdf_scene.h"
 

@@ -1,4 +1,4 @@
-#include "diff_rigid_body/rigid_body.h"
+#include "diff_rigid_body/mass_property_checks.h"
 
 #include <algorithm>
 #include <cfloat>

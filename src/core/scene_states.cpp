@@ -8,8 +8,8 @@
 #include <unordered_set>
 
 #include "diff_rigid_body/exceptions.h"
+#include "diff_rigid_body/kinematics.h"
 #include "request_checks.h"
-#include "scene_queries_articulated.h"
 
 namespace diff_rigid_body
 {
@@ -18,13 +18,17 @@ using detail::sizeMismatch;
 
 namespace
 {
-/// Refuses an articulated body's x whose link poses overflow (a prismatic
-/// joint at 1e308, say): tf would otherwise publish inf. Free bodies keep
-/// version 1's rule (q finite).
-void requireFinitePoses(const SceneBody& body, const Eigen::VectorXd& x, const std::string& field)
+/// Refuses an x whose link poses overflow (a prismatic joint at 1e308,
+/// say): tf would otherwise publish inf. A free object's pose is its q,
+/// already checked finite.
+void requireFinitePoses(const BodyModel& body, BodyWorkspace<double>& ws, const Eigen::VectorXd& x,
+                        const std::string& field)
 {
-  if (body.articulated && !detail::poseIsFinite(*body.articulated, articulatedPose(*body.articulated, x.data())))
-    reject(field + ": the link poses of body '" + body.body.name + "' overflow at these values");
+  if (body.isFreeObject())
+    return;
+  forwardKinematics(body, ws, x.data());
+  if (!kinematicsAreFinite(body, ws))
+    reject(field + ": the link poses of body '" + body.name + "' overflow at these values");
 }
 
 // At most 64 bytes of a name for a message: a hostile name may be huge.
@@ -38,8 +42,8 @@ SceneState SceneQueries::initialState() const
 {
   SceneState state;
   state.reserve(scene_.bodies.size());
-  for (const SceneBody& body : scene_.bodies)
-    state.push_back(body.initial_state);
+  for (const BodyModel& body : scene_.bodies)
+    state.push_back(body.initial_x);
   return state;
 }
 
@@ -52,27 +56,37 @@ std::size_t SceneQueries::bodyIndex(const std::string& name, const std::string& 
   constexpr std::size_t kListed = 20;
   std::string known;
   for (std::size_t i = 0; i < std::min(kListed, scene_.bodies.size()); ++i)
-    known += (known.empty() ? "" : ", ") + scene_.bodies[i].body.name;
+    known += (known.empty() ? "" : ", ") + scene_.bodies[i].name;
   if (scene_.bodies.size() > kListed)
     known += ", ... (" + std::to_string(scene_.bodies.size()) + " bodies)";
   reject(field + ": unknown body '" + shortened(name) + "' (bodies: " + known + ")");
 }
 
-std::vector<std::size_t> SceneQueries::bodyIndices(const std::vector<std::string>& names,
-                                                   const std::string& field) const
+void SceneQueries::bodyIndices(const std::vector<std::string>& names, const char* field,
+                               std::vector<std::size_t>& indices) const
 {
   if (names.size() > RequestLimits::kMaxStates)
     reject(sizeMismatch(field, "at most " + std::to_string(RequestLimits::kMaxStates) + " names", names.size()));
-  std::vector<std::size_t> indices;
+  indices.clear();
   if (names.empty())
   {
     for (std::size_t i = 0; i < scene_.bodies.size(); ++i)
       indices.push_back(i);
-    return indices;
+    return;
   }
   indices.reserve(names.size());
   for (std::size_t i = 0; i < names.size(); ++i)
-    indices.push_back(bodyIndex(names[i], field + "[" + std::to_string(i) + "]"));
+  {
+    const auto found = body_index_.find(names[i]);  // the message is built only for a refusal
+    indices.push_back(found != body_index_.end() ? found->second :
+                                                   bodyIndex(names[i], std::string(field) + "[" + std::to_string(i) + "]"));
+  }
+}
+
+std::vector<std::size_t> SceneQueries::bodyIndices(const std::vector<std::string>& names, const char* field) const
+{
+  std::vector<std::size_t> indices;
+  bodyIndices(names, field, indices);
   return indices;
 }
 
@@ -91,17 +105,17 @@ SceneState SceneQueries::applyStates(const SceneState& current, const std::vecto
     if (!seen.insert(index).second)
       reject(field + ".name: body '" + updates[i].name + "' appears more than once");
     const std::string q_field = field + ".q (body '" + updates[i].name + "')";
-    const std::size_t dofs = scene_.bodies[index].dofs();
-    if (static_cast<std::size_t>(updates[i].q.size()) != dofs)
+    const std::size_t dofs = this->dofs(index);
+    if (static_cast<std::size_t>(updates[i].x.size()) != dofs)
       reject(sizeMismatch(q_field, std::to_string(dofs) + " values (the body's dofs)",
-                          static_cast<std::size_t>(updates[i].q.size())));
-    requireFinite(updates[i].q.data(), dofs, q_field);
-    requireFinitePoses(scene_.bodies[index], updates[i].q, q_field);
+                          static_cast<std::size_t>(updates[i].x.size())));
+    requireFinite(updates[i].x.data(), dofs, q_field.c_str());
+    requireFinitePoses(scene_.bodies[index], workspace(index), updates[i].x, q_field);
     indices.push_back(index);
   }
   SceneState next = current;
   for (std::size_t i = 0; i < updates.size(); ++i)
-    next[indices[i]] = updates[i].q;
+    next[indices[i]] = updates[i].x;
   return next;
 }
 
@@ -136,7 +150,7 @@ SceneState SceneQueries::applyJointPositions(const SceneState& current, const st
   std::sort(changed.begin(), changed.end());
   changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
   for (std::size_t index : changed)
-    requireFinitePoses(scene_.bodies[index], next[index], "position");
+    requireFinitePoses(scene_.bodies[index], workspace(index), next[index], "position");
   return next;
 }
 
@@ -144,7 +158,7 @@ std::vector<NamedState> SceneQueries::getStates(const SceneState& current, const
 {
   std::vector<NamedState> states;
   for (std::size_t index : bodyIndices(names, "bodies"))
-    states.push_back({ scene_.bodies[index].body.name, current[index] });
+    states.push_back({ scene_.bodies[index].name, current[index] });
   return states;
 }
 }  // namespace diff_rigid_body

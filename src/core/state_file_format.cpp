@@ -58,34 +58,37 @@ void hashPoints(const Matrix3X<double>& points, Fnv1a& hash)
     hash.number(points.data()[i]);
 }
 
-// What places an articulated body's vertices at x: its tree, every joint
-// (name, type, origin, axis, coordinate, mimic factors), the segments' mass
-// properties and vertex ranges, the vertices and the joint names in x order.
-void hashArticulated(const ArticulatedBody& body, Fnv1a& hash)
+// What places a tree's vertices at x: its segments, every joint (name, type,
+// placement, axis, coordinate, mimic factors), the segments' mass properties,
+// frames and vertex ranges, the vertices and the joint names in x order.
+void hashTree(const BodyModel& body, Fnv1a& hash)
 {
-  hash.text("articulated");
-  hash.number(static_cast<std::uint64_t>(body.floating_root));
+  hash.text("tree");
+  hash.number(static_cast<std::uint64_t>(body.hasFreeRoot()));
   hash.number(static_cast<std::uint64_t>(body.segments.size()));
   for (const Segment& segment : body.segments)
   {
     hash.text(segment.link);
     hash.number(static_cast<std::uint64_t>(static_cast<std::int64_t>(segment.parent)));
     hash.text(segment.joint);
-    hash.number(static_cast<std::uint64_t>(segment.motion == JointMotion::Prismatic));
+    hash.number(static_cast<std::uint64_t>(segment.joint_type));
     for (int i = 0; i < 9; ++i)
-      hash.number(segment.origin.linear()(i / 3, i % 3));
+      hash.number(segment.placement_rotation(i / 3, i % 3));
     for (int i = 0; i < 3; ++i)
-      hash.number(segment.origin.translation()[i]);
+      hash.number(segment.placement_translation[i]);
     for (int i = 0; i < 3; ++i)
       hash.number(segment.axis[i]);
-    hash.number(static_cast<std::uint64_t>(static_cast<std::int64_t>(segment.coordinate)));
-    hash.number(segment.multiplier);
+    const Dof& dof = body.dofs[static_cast<std::size_t>(segment.first_dof)];
+    hash.number(static_cast<std::uint64_t>(static_cast<std::int64_t>(dof.coordinate)));
+    hash.number(dof.multiplier);
     hash.number(segment.offset);
-    hash.number(segment.mass_properties.mass);
+    hash.number(segment.inertia.mass);
     for (int i = 0; i < 3; ++i)
-      hash.number(segment.mass_properties.com[i]);
+      hash.number(segment.inertia.com[i]);
     for (int i = 0; i < 9; ++i)
-      hash.number(segment.mass_properties.inertia(i / 3, i % 3));
+      hash.number(segment.inertia.inertia(i / 3, i % 3));
+    for (int i = 0; i < 3; ++i)
+      hash.number(segment.link_origin[i]);
     hash.number(static_cast<std::uint64_t>(segment.vertex_begin));
     hash.number(static_cast<std::uint64_t>(segment.vertex_count));
   }
@@ -106,8 +109,8 @@ std::size_t maxStateFileSize(std::size_t body_count)
 std::size_t maxStateFileSize(const Scene& scene)
 {
   std::size_t extra_coordinates = 0;
-  for (const SceneBody& body : scene.bodies)
-    extra_coordinates += body.dofs() > 6 ? body.dofs() - 6 : 0;
+  for (const BodyModel& body : scene.bodies)
+    extra_coordinates += body.coordinates > 6 ? body.coordinates - 6 : 0;
   return maxStateFileSize(scene.bodies.size()) + 32 * extra_coordinates;
 }
 
@@ -117,21 +120,25 @@ std::uint64_t sceneFingerprint(const Scene& scene)
   hash.text(kHeader);
   hash.text(scene.fixed_frame);
   hash.number(static_cast<std::uint64_t>(scene.bodies.size()));
-  for (const SceneBody& scene_body : scene.bodies)
+  for (const BodyModel& body : scene.bodies)
   {
-    const RigidBody& body = scene_body.body;
+    // A free object hashes as version 1 did: name, mass, inertia, COM offset, vertices.
     hash.text(body.name);
-    hash.number(body.mass);
+    hash.number(body.isFreeObject() ? body.segments[0].inertia.mass : body.mass());
     for (int i = 0; i < 9; ++i)
-      hash.number(body.inertia_body(i / 3, i % 3));
+      hash.number(body.segments[0].inertia.inertia(i / 3, i % 3));
+    const Eigen::Vector3d com_offset = body.rootComOffset();
     for (int i = 0; i < 3; ++i)
-      hash.number(body.com_offset[i]);
+      hash.number(com_offset[i]);
+    if (!body.isFreeObject())
+    {
+      hashTree(body, hash);
+      continue;
+    }
     hash.number(static_cast<std::uint64_t>(body.vertices.cols()));
     for (Eigen::Index v = 0; v < body.vertices.cols(); ++v)
       for (int i = 0; i < 3; ++i)
         hash.number(body.vertices(i, v));
-    if (scene_body.articulated)  // nothing more for a free body: version 1's fingerprint
-      hashArticulated(*scene_body.articulated, hash);
   }
   return hash.value();
 }
@@ -158,8 +165,8 @@ std::string formatStateFile(const Scene& scene, const SceneState& state)
   text += "bodies " + std::to_string(state.size()) + "\n";
   for (std::size_t i = 0; i < state.size(); ++i)
   {
-    const std::string& name = scene.bodies[i].body.name;
-    const std::size_t dofs = scene.bodies[i].dofs();
+    const std::string& name = scene.bodies[i].name;
+    const std::size_t dofs = scene.bodies[i].coordinates;
     if (static_cast<std::size_t>(state[i].size()) != dofs)
       fail("cannot save " + std::to_string(state[i].size()) + " values for body '" + name + "' of " +
            std::to_string(dofs) + " dofs");
@@ -269,10 +276,10 @@ NamedState parseBodyLine(const std::string& line, std::size_t number, std::size_
   NamedState body;
   if (!decodeName(tokens[1], body.name) || body.name.empty())
     fail(where + ": malformed body name '" + quoted(tokens[1]) + "'");
-  body.q.resize(static_cast<Eigen::Index>(tokens.size() - 2));
+  body.x.resize(static_cast<Eigen::Index>(tokens.size() - 2));
   for (std::size_t k = 0; k + 2 < tokens.size(); ++k)
   {
-    double& value = body.q[static_cast<Eigen::Index>(k)];
+    double& value = body.x[static_cast<Eigen::Index>(k)];
     if (!parseValue(tokens[2 + k], value))
       fail(where + ": q[" + std::to_string(k) + "] of body '" + quoted(body.name) + "': not a hex float: '" +
            quoted(tokens[2 + k], 40) + "'");
@@ -292,8 +299,8 @@ std::string names(const std::vector<std::string>& list)
 void checkSameScene(const std::vector<std::string>& file_names, std::uint64_t fingerprint, const Scene& scene)
 {
   std::vector<std::string> scene_names;
-  for (const SceneBody& body : scene.bodies)
-    scene_names.push_back(body.body.name);
+  for (const BodyModel& body : scene.bodies)
+    scene_names.push_back(body.name);
   if (file_names != scene_names)
     fail("saved for other bodies: the file has " + names(file_names) + ", the scene has " + names(scene_names));
   const std::uint64_t expected = sceneFingerprint(scene);
@@ -315,15 +322,15 @@ SceneState parseStateFile(const std::string& text, const Scene& scene)
   state.reserve(count);
   for (std::size_t i = 0; i < count; ++i)
   {
-    NamedState body = parseBodyLine(lines.text[i + 3], i + 4, i < scene.bodies.size() ? scene.bodies[i].dofs() : 6);
+    NamedState body = parseBodyLine(lines.text[i + 3], i + 4, i < scene.bodies.size() ? scene.bodies[i].coordinates : 6);
     file_names.push_back(std::move(body.name));
-    state.push_back(std::move(body.q));
+    state.push_back(std::move(body.x));
   }
   checkSameScene(file_names, fingerprint, scene);
   // Same bodies in the same order: each line has its body's dofs.
   for (std::size_t i = 0; i < count; ++i)
-    if (static_cast<std::size_t>(state[i].size()) != scene.bodies[i].dofs())
-      fail(expectedBodyLine("line " + std::to_string(i + 4), scene.bodies[i].dofs(), lines.text[i + 3]));
+    if (static_cast<std::size_t>(state[i].size()) != scene.bodies[i].coordinates)
+      fail(expectedBodyLine("line " + std::to_string(i + 4), scene.bodies[i].coordinates, lines.text[i + 3]));
   return state;
 }
 

@@ -8,6 +8,7 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include "diff_rigid_body/exceptions.h"
+#include "urdf_topology.h"
 
 namespace diff_rigid_body
 {
@@ -66,6 +67,30 @@ std::vector<std::string> namesInDocumentOrder(const std::string& urdf_xml, const
       names.emplace_back(name);
   }
   return names;
+}
+
+UrdfDescription readUrdfDescription(const std::string& urdf_xml)
+{
+  UrdfDescription description;
+  description.link_order = namesInDocumentOrder(urdf_xml, "link");
+  description.joint_order = namesInDocumentOrder(urdf_xml, "joint");
+  description.model = parseUrdfModel(urdf_xml);
+  std::vector<JointEdge> edges;
+  for (const std::string& name : description.joint_order)
+    if (const urdf::JointConstSharedPtr joint = description.model->getJoint(name))
+      edges.push_back({ name, joint->parent_link_name, joint->child_link_name });
+  checkTreeTopology(description.link_order, edges);
+  if (!description.model->getRoot())
+    throw SceneDescriptionError("robot description: no root link");
+  for (std::size_t i = 0; i < description.link_order.size(); ++i)
+    description.link_index.emplace(description.link_order[i], i);
+  return description;
+}
+
+bool movesOneCoordinate(int joint_type)
+{
+  return joint_type == urdf::Joint::REVOLUTE || joint_type == urdf::Joint::CONTINUOUS ||
+         joint_type == urdf::Joint::PRISMATIC;
 }
 
 Eigen::Isometry3d toIsometry(const urdf::Pose& pose)

@@ -1,8 +1,10 @@
 // urdfdom glue for the scene builder (not installed): parsing with urdfdom's
-// errors captured, link order, poses and joint names.
+// errors captured, the joint graph checked, document order, poses and joint
+// names.
 #pragma once
 
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -24,6 +26,26 @@ urdf::ModelInterfaceSharedPtr parseUrdfModel(const std::string& urdf_xml);
 /// order (urdfdom keeps them in std::maps). Throws SceneDescriptionError for
 /// malformed XML or a missing <robot>.
 std::vector<std::string> namesInDocumentOrder(const std::string& urdf_xml, const char* element);
+
+/// A URDF as the scene builder reads it: urdfdom's model, whose joints form
+/// a tree (urdf_topology.h), and the document order that urdfdom's maps lose.
+struct UrdfDescription
+{
+  urdf::ModelInterfaceSharedPtr model;
+  std::vector<std::string> link_order;   ///< link names in document order
+  std::vector<std::string> joint_order;  ///< joint names in document order
+  std::unordered_map<std::string, std::size_t> link_index;  ///< name -> index in link_order
+
+  const urdf::Link& link(const std::string& name) const { return *model->getLink(name); }
+  const urdf::Joint& joint(const std::string& name) const { return *model->getJoint(name); }
+};
+
+/// Parses `urdf_xml` (parseUrdfModel, namesInDocumentOrder) and checks that
+/// its joints form one tree (checkTreeTopology). Throws SceneDescriptionError.
+UrdfDescription readUrdfDescription(const std::string& urdf_xml);
+
+/// Revolute, continuous and prismatic joints: one coordinate each.
+bool movesOneCoordinate(int joint_type);
 
 /// The pose as an isometry (quaternion normalised).
 Eigen::Isometry3d toIsometry(const urdf::Pose& pose);

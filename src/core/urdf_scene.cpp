@@ -1,135 +1,116 @@
+// URDF to scene, as pure steps with explicit inputs: read the description
+// (urdf_model.h: parse, check the joint graph), place its links
+// (link_tree.h), choose the links that start bodies, and build each body
+// (body_builder.h, rigid_group.h, body_coordinates.h).
 #include "diff_rigid_body/urdf_scene.h"
 
 #include <algorithm>
 #include <cmath>
 #include <fstream>
-#include <map>
 #include <set>
 #include <sstream>
-#include <unordered_map>
-
-#include <urdf_model/model.h>
 
 #include "diff_rigid_body/exceptions.h"
-#include "diff_rigid_body/rpy.h"
+#include "body_builder.h"
 #include "body_names.h"
-#include "scene_builder.h"
+#include "link_tree.h"
+#include "rigid_group.h"
 #include "urdf_model.h"
 
 namespace diff_rigid_body
 {
-namespace detail
+namespace
 {
-Scene SceneBuilder::build()
+using detail::LinkTree;
+using detail::UrdfDescription;
+
+// With JointHandling::Free every moving link starts a body; with Model the
+// children of floating and planar joints and the moving links joined to a
+// static link do.
+std::vector<std::string> bodyRoots(const UrdfDescription& description, const LinkTree& tree,
+                                   const SceneOptions& options)
 {
-  Scene scene;
-  placeLinks(model_->getRoot());
-  const std::string root = model_->getRoot()->name;
-  scene.fixed_frame = options_.fixed_frame.empty() ? root : options_.fixed_frame;
-  const auto fixed = owner_.find(scene.fixed_frame);
-  if (fixed == owner_.end() || !fixed->second.empty())
-    throw SceneDescriptionError("parameter fixed_frame: '" + scene.fixed_frame + "' is not the root link '" + root +
-                                "' or a link fixed to it");
-  const Eigen::Isometry3d fixed_from_root = pose_in_root_.at(scene.fixed_frame).inverse();
-
-  std::vector<std::string> moving_links;
-  for (const std::string& name : document_order_)
-  {
-    link_document_index_.emplace(name, link_document_index_.size());
-    const std::string& owner = owner_.at(name);
-    if (owner.empty())
-    {
-      if (name != scene.fixed_frame)
-        scene.static_links.push_back({ name, fixed_from_root * pose_in_root_.at(name) });
-    }
-    else if (owner == name)
-      moving_links.push_back(name);
-    else
-      merged_links_[owner].push_back(name);  // one pass: loading stays linear in the links
-  }
-  if (moving_links.empty())
-    throw SceneDescriptionError("robot description: no body (no link is the child of a floating, revolute, "
-                                "continuous, prismatic or planar joint)");
-  const std::vector<std::string> body_links = bodyRoots(moving_links);
-
-  std::set<std::string> selected(options_.bodies.begin(), options_.bodies.end());
-  for (const std::string& name : options_.bodies)
-  {
-    if (std::find(body_links.begin(), body_links.end(), name) == body_links.end())
-      throw SceneDescriptionError("parameter bodies: unknown body '" + name +
-                                  "' (bodies: " + formatBodyNames(body_links) + ")");
-  }
-
-  for (const std::string& name : body_links)
-  {
-    if (!selected.empty() && !selected.count(name))
-      continue;
-    const urdf::JointConstSharedPtr& joint = model_->getLink(name)->parent_joint;
-    const bool free_body = options_.joints == JointHandling::Free ||
-                           (!movesOneCoordinate(joint->type) && treeSegments(name).size() == 1);
-    scene.bodies.push_back(free_body ? buildFreeBody(name, fixed_from_root) :
-                                       buildArticulatedBody(name, fixed_from_root));
-    if (joint->type == urdf::Joint::PLANAR || (options_.joints == JointHandling::Free && movesOneCoordinate(joint->type)))
-      scene.unmodelled_joints.push_back("joint '" + joint->name + "' (" + jointTypeName(joint->type) +
-                                        "): its constraint is not modelled; child '" + name +
-                                        "' is a free body posed at joint value 0");
-  }
-  scene.warnings = std::move(warnings_);
-  return scene;
-}
-
-// The links that start a body, in document order: with JointHandling::Free
-// every moving link; with Model the children of floating and planar joints
-// and the moving links joined to a static link.
-std::vector<std::string> SceneBuilder::bodyRoots(const std::vector<std::string>& moving_links) const
-{
-  if (options_.joints == JointHandling::Free)
-    return moving_links;
+  if (options.joints == JointHandling::Free)
+    return tree.moving_links;
   std::vector<std::string> roots;
-  for (const std::string& name : moving_links)
-    if (isBodyRoot(name))
+  for (const std::string& name : tree.moving_links)
+  {
+    const urdf::Joint& joint = *description.link(name).parent_joint;
+    if (!detail::movesOneCoordinate(joint.type) || tree.isStatic(description, joint.parent_link_name))
       roots.push_back(name);
+  }
   return roots;
 }
 
-bool SceneBuilder::isBodyRoot(const std::string& link_name) const
+// The fixed frame (the root link or a link fixed to it) and its pose.
+Eigen::Isometry3d fixedFromRoot(const UrdfDescription& description, const LinkTree& tree, Scene& scene,
+                                const SceneOptions& options)
 {
-  const urdf::JointConstSharedPtr& joint = model_->getLink(link_name)->parent_joint;
-  return !movesOneCoordinate(joint->type) || owner_.at(joint->parent_link_name).empty();
+  const std::string root = description.model->getRoot()->name;
+  scene.fixed_frame = options.fixed_frame.empty() ? root : options.fixed_frame;
+  const auto fixed = description.link_index.find(scene.fixed_frame);
+  if (fixed == description.link_index.end() || !tree.owner[fixed->second].empty())
+    throw SceneDescriptionError("parameter fixed_frame: '" + scene.fixed_frame + "' is not the root link '" + root +
+                                "' or a link fixed to it");
+  return tree.pose_in_root[fixed->second].inverse();
 }
 
-SceneBody SceneBuilder::buildFreeBody(const std::string& body_name, const Eigen::Isometry3d& fixed_from_root)
+// Checks options.bodies against `roots` and returns the roots to model.
+std::vector<std::string> selectedRoots(const std::vector<std::string>& roots, const SceneOptions& options)
 {
-  SceneBody scene_body;
-  const urdf::JointConstSharedPtr& joint = model_->getLink(body_name)->parent_joint;
-  scene_body.joint_name = joint->name;
-  scene_body.joint_type = jointTypeName(joint->type);
-  RigidGroup group = buildRigidGroup(body_name, true);
-  scene_body.body.name = body_name;
-  scene_body.body.mass = group.mass.mass;
-  scene_body.body.com_offset = group.mass.com;
-  scene_body.body.inertia_body = group.mass.inertia;
-  scene_body.body.vertices = std::move(group.vertices);
-  scene_body.links = std::move(group.links);
-
-  // Initial state: link axes' RPY and COM position, in the fixed frame.
-  const Eigen::Isometry3d body_in_fixed = fixed_from_root * pose_in_root_.at(body_name);
-  scene_body.initial_state = Eigen::VectorXd(6);
-  scene_body.initial_state.head<3>() = matrixToRpy(body_in_fixed.linear());
-  scene_body.initial_state.tail<3>() = body_in_fixed * group.mass.com;
-  if (!scene_body.initial_state.allFinite())
-    throw SceneDescriptionError("body '" + body_name +
-                                "': initial state is not finite (its joint origins and COM offset add up "
-                                "beyond the range of double)");
-  warnIfGimbalLocked(body_name, scene_body.joint_name, scene_body.joint_type, scene_body.initial_state[1]);
-  return scene_body;
+  for (const std::string& name : options.bodies)
+    if (std::find(roots.begin(), roots.end(), name) == roots.end())
+      throw SceneDescriptionError("parameter bodies: unknown body '" + name +
+                                  "' (bodies: " + detail::formatBodyNames(roots) + ")");
+  if (options.bodies.empty())
+    return roots;
+  const std::set<std::string> selected(options.bodies.begin(), options.bodies.end());
+  std::vector<std::string> kept;
+  for (const std::string& name : roots)
+    if (selected.count(name))
+      kept.push_back(name);
+  return kept;
 }
 
-}  // namespace detail
+void addBody(const UrdfDescription& description, const LinkTree& tree, const std::string& name,
+             const Eigen::Isometry3d& fixed_from_root, detail::LoadContext& context, Scene& scene)
+{
+  const urdf::Joint& joint = *description.link(name).parent_joint;
+  const bool model_joints = context.options.joints == JointHandling::Model;
+  const detail::RootKind kind = model_joints && detail::movesOneCoordinate(joint.type) ?
+                                    detail::RootKind::FixedBase :
+                                    detail::RootKind::Free;
+  scene.bodies.push_back(detail::buildBodyModel(description, tree, name, kind, model_joints, fixed_from_root, context));
+  if (joint.type == urdf::Joint::PLANAR || (!model_joints && detail::movesOneCoordinate(joint.type)))
+    scene.unmodelled_joints.push_back("joint '" + joint.name + "' (" + detail::jointTypeName(joint.type) +
+                                      "): its constraint is not modelled; child '" + name +
+                                      "' is a free body posed at joint value 0");
+}
+}  // namespace
 
 Scene loadSceneFromUrdf(const std::string& urdf_xml, const SceneOptions& options)
 {
-  return detail::SceneBuilder(urdf_xml, options).build();
+  const UrdfDescription description = detail::readUrdfDescription(urdf_xml);
+  if (options.density && !(std::isfinite(*options.density) && *options.density > 0.0))
+  {
+    std::ostringstream why;
+    why << "parameter density: must be finite and > 0 kg/m^3, got " << *options.density;
+    throw SceneDescriptionError(why.str());
+  }
+  const LinkTree tree = detail::placeLinks(description);
+  Scene scene;
+  const Eigen::Isometry3d fixed_from_root = fixedFromRoot(description, tree, scene, options);
+  for (std::size_t i = 0; i < description.link_order.size(); ++i)
+    if (tree.owner[i].empty() && description.link_order[i] != scene.fixed_frame)
+      scene.static_links.push_back({ description.link_order[i], fixed_from_root * tree.pose_in_root[i] });
+  if (tree.moving_links.empty())
+    throw SceneDescriptionError("robot description: no body (no link is the child of a floating, revolute, "
+                                "continuous, prismatic or planar joint)");
+  detail::LoadContext context(options);
+  for (const std::string& name : selectedRoots(bodyRoots(description, tree, options), options))
+    addBody(description, tree, name, fixed_from_root, context, scene);
+  scene.warnings = std::move(context.warnings);
+  return scene;
 }
 
 Scene loadSceneFromUrdfFile(const std::string& path, SceneOptions options)
@@ -145,14 +126,6 @@ Scene loadSceneFromUrdfFile(const std::string& path, SceneOptions options)
     options.base_directory = slash == std::string::npos ? "." : path.substr(0, slash);
   }
   return loadSceneFromUrdf(text.str(), options);
-}
-
-Eigen::Isometry3d linkPoseFromState(const Vector6<double>& q, const Eigen::Vector3d& com_offset)
-{
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.linear() = rpyToMatrix(RpyTrig<double>(q));
-  pose.translation() = q.tail<3>() - pose.linear() * com_offset;
-  return pose;
 }
 
 }  // namespace diff_rigid_body

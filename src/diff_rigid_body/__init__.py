@@ -2,6 +2,8 @@
 
 ``diff_rigid_body.client``: :class:`RigidBodyClient` (numpy arrays over
 persistent service connections) and :class:`DiffRigidBodyError`.
+``diff_rigid_body.pool``: :class:`RigidBodyPool` (the same methods over several
+instances: K configurations sharded, failover) and :class:`PoolError`.
 ``diff_rigid_body.pose_fitting`` and ``diff_rigid_body.trajectory_energy``:
 the example optimisers run by ``nodes/demo_client.py``.
 
@@ -13,7 +15,11 @@ beside these modules (catkin merges them).
 
 
 def __getattr__(name):
-    if name in ('RigidBodyClient', 'DiffRigidBodyError', 'Bodies', 'MassMatrices'):
+    if name in ('RigidBodyClient', 'DiffRigidBodyError', 'Bodies', 'MassMatrices', 'InverseDynamicsResult',
+                'ForwardDynamicsResult'):
         from diff_rigid_body import client
         return getattr(client, name)
+    if name in ('RigidBodyPool', 'PoolError'):
+        from diff_rigid_body import pool
+        return getattr(pool, name)
     raise AttributeError("module 'diff_rigid_body' has no attribute %r" % name)

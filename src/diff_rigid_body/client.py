@@ -2,10 +2,13 @@
 
 Wraps the node's services (those of include/diff_rigid_body_ros/services.h
 that have a client method) with persistent connections and returns numpy
-arrays. Response arrays are deserialised straight from the wire with
-``np.frombuffer`` (``rospy.numpy_msg``): no per-element Python loop. The
-arrays returned are read-only views on the received buffer; ``.copy()`` one
-to modify it.
+arrays, with no per-element Python loop either way: a request's numeric
+arrays are flat numpy buffers of their wire type (``client_arrays.wire_message``)
+written to the socket as they are, and a response's arrays are
+``np.frombuffer`` views of the buffer it was received into
+(``diff_rigid_body.tcpros``; ``transport='rospy'``: ``rospy.ServiceProxy``
+with ``rospy.numpy_msg`` both ways, the same bytes, read-only arrays).
+``.copy()`` a returned array before modifying it.
 
 Shapes (n bodies, N vertices, K configurations). A body's coordinates x
 have d = dof values (``bodies().dofs``): a free body's x is
@@ -29,6 +32,11 @@ floating root's q (if it floats), then its joint positions (interface.md,
                                 float32 with ``single_precision``; (K, N, 3),
                                 (K, N, 3, c) for a q of shape (K, d)
 ``backprop(...)``               dL/dx, (d,); (K, d) for a q of shape (K, d)
+``inverse_dynamics(...)``       tau = M x'' + c + g, c, g: (n, d) [N m, N]; C,
+                                dtau/dx, dtau/dx': (n, d, d), row = tau component;
+                                K configurations and bodies of different d as M
+``forward_dynamics(...)``       x'' = M^-1 (tau - c - g): (n, d); dx''/dx,
+                                dx''/dx', dx''/dtau: (n, d, d); as inverse_dynamics
 ``get_state()``                 dict name -> x (d,)
 ==============================  ===============================================
 
@@ -39,6 +47,9 @@ A service that answers ``success: False`` raises :class:`DiffRigidBodyError`
 with the node's message. If a persistent connection drops (the node was
 restarted), the call reconnects once, waiting up to ``timeout`` for the
 service, and is retried; every service is idempotent, so a retry is safe.
+With ``reconnect=False`` the call raises instead (one of
+:data:`CONNECTION_ERRORS`): :class:`~diff_rigid_body.pool.RigidBodyPool`
+sends the work to another instance at once.
 
 A client is not thread-safe (persistent connections are not): use one per
 thread.
@@ -49,124 +60,31 @@ import numpy as np
 import rospy
 from rospy.numpy_msg import numpy_msg
 
+from diff_rigid_body.client_arrays import (AnswerShape, floats, indices, optional_values, vertex_blocks,
+                                          vertex_configurations, wire_message)
+from diff_rigid_body.client_types import (Bodies, DiffRigidBodyError, ForwardDynamicsResult,
+                                         InverseDynamicsResult, Joint, Link, MassMatrices, bodies_from_response)
 from diff_rigid_body.msg import BodyState
-from diff_rigid_body.srv import (Backprop, GetBodies, GetMassMatrix, GetState, GetVertexJacobians,
-                                 GetVertexJacobiansCompact, SetState)
+from diff_rigid_body.srv import (Backprop, ForwardDynamics, GetBodies, GetMassMatrix, GetState, GetVertexJacobians,
+                                 GetVertexJacobiansCompact, InverseDynamics, SetState)
+from diff_rigid_body.tcpros import ServiceConnection
 
-__all__ = ['DiffRigidBodyError', 'RigidBodyClient', 'Bodies', 'MassMatrices']
+__all__ = ['DiffRigidBodyError', 'RigidBodyClient', 'Bodies', 'Joint', 'Link', 'MassMatrices', 'InverseDynamicsResult',
+           'ForwardDynamicsResult', 'CONNECTION_ERRORS']
 
-
-class DiffRigidBodyError(RuntimeError):
-    """A service of rigid_body_server refused a request (``success: False``).
-
-    ``service`` is the service's name, ``message`` the node's explanation (it
-    names the body, index or field at fault). The node's state is unchanged.
-    """
-
-    def __init__(self, service, message):
-        super().__init__('%s: %s' % (service, message))
-        self.service = service
-        self.message = message
-
-
-#: ``get_bodies``: fixed_frame (str), names (list of str), masses (n,) [kg],
-#: inertias (n, 3, 3) [kg m^2] about the COM in body axes, com_offsets (n, 3) [m]
-#: in the link frame, vertex_counts (n,); dofs (n,), joints (per body: a list of
-#: :data:`Joint`) and links (per body: a list of :data:`Link`, in vertex order).
-Bodies = collections.namedtuple('Bodies', 'fixed_frame names masses inertias com_offsets vertex_counts dofs joints '
-                                          'links')
-
-#: One joint coordinate of a body: name, lower and upper limit [rad or m] (+-inf where none).
-Joint = collections.namedtuple('Joint', 'name lower upper')
-
-#: One link of a body: name, mass [kg] (0 for a massless frame), inertia (3, 3) [kg m^2]
-#: about its COM in link axes, com_offset (3,) [m] in its frame, and its vertices:
-#: the body's vertices first..first+vertex_count-1 (contiguous, in link order).
-Link = collections.namedtuple('Link', 'name mass inertia com_offset first_vertex vertex_count')
-
-#: ``get_mass_matrix``: bodies (list of str), M, dM (None unless derivatives
-#: were asked for) and cos_theta ((n,) or (K, n): the gimbal-lock diagnostic).
-MassMatrices = collections.namedtuple('MassMatrices', 'bodies M dM cos_theta')
-
-
-def _split(counts, items):
-    """``items`` cut into consecutive lists of ``counts[i]`` items."""
-    ends = np.cumsum(np.asarray(counts, dtype=np.int64))
-    return [list(items[end - count:end]) for count, end in zip(counts, ends)]
-
-
-def _links(r):
-    """The links of a get_bodies response, flattened, with their first vertex within their body."""
-    inertias = np.asarray(r.link_inertias).reshape(-1, 3, 3)
-    coms = np.asarray(r.link_com_offsets).reshape(-1, 3)
-    links = []
-    for body_links in _split(r.link_counts, list(range(len(r.link_names)))):
-        first = 0
-        for k in body_links:
-            links.append(Link(r.link_names[k], r.link_masses[k], inertias[k], coms[k], first,
-                              int(r.link_vertex_counts[k])))
-            first += int(r.link_vertex_counts[k])
-    return links
+#: What a call raises when the node cannot be reached or the connection drops (not a refusal).
+CONNECTION_ERRORS = (rospy.ServiceException, rospy.ROSException, rospy.exceptions.TransportException, OSError)
 
 
 def _numpy_service(service_class):
-    """The service type with a response that deserialises its arrays with np.frombuffer."""
+    """The service type whose request writes its arrays with ndarray.tobytes and whose response
+    reads them with np.frombuffer (rospy.numpy_msg both ways)."""
     return type('Numpy' + service_class.__name__, (object,), {
         '_type': service_class._type,
         '_md5sum': service_class._md5sum,
-        '_request_class': service_class._request_class,
+        '_request_class': numpy_msg(service_class._request_class),
         '_response_class': numpy_msg(service_class._response_class),
     })
-
-
-def _floats(values):
-    """A flat list of floats for a float64[] request field (struct.pack takes lists fastest)."""
-    return np.asarray(values, dtype=np.float64).ravel().tolist()
-
-
-def _indices(vertices):
-    return [] if vertices is None else np.asarray(vertices, dtype=np.uint32).ravel().tolist()
-
-
-def _pose(q):
-    """A request's optional q: empty = the node's current state, else the body's x (d values,
-    or K d for K configurations)."""
-    return [] if q is None else _floats(q)
-
-
-def _configurations(q, dofs):
-    """K for a vertex request's q of shape (K, d) (or K d flat values, K > 1), or None for one
-    configuration (None, empty or (d,)); ``dofs()`` gives d, asked only for a flat q. A size the
-    node refuses is left to the node's message."""
-    if q is None:
-        return None
-    if np.ndim(q) >= 2:
-        if np.shape(q)[0] == 0:  # an empty q would mean the current state
-            raise ValueError('q: at least one configuration, got shape %s' % (np.shape(q),))
-        return int(np.shape(q)[0])
-    size = int(np.size(q))
-    if size == 0:
-        return None
-    d = dofs()
-    return None if d == 0 or size == d or size % d else size // d
-
-
-def _blocks(values, configurations, vertices, columns=None):
-    """``values`` as (N, 3) (or (N, 3, columns)), with a leading K axis when ``configurations`` = K
-    is not None. ``vertices`` = N."""
-    shape = (vertices, 3) if columns is None else (vertices, 3, columns)
-    values = np.asarray(values)
-    return values.reshape(shape if configurations is None else (configurations,) + shape)
-
-
-def _per_body(values, dofs, configurations, power):
-    """The matrices of a get_mass_matrix field (d_i^power values per matrix, configuration-major)
-    of each body, as a list of (K,) + (d_i,) * power arrays."""
-    sizes = [d ** power for d in dofs]
-    rows = np.asarray(values).reshape(configurations, sum(sizes))
-    starts = np.concatenate([[0], np.cumsum(sizes)]).astype(int)
-    return [rows[:, starts[i]:starts[i + 1]].reshape((configurations,) + (d,) * power)
-            for i, d in enumerate(dofs)]
 
 
 class RigidBodyClient(object):
@@ -177,6 +95,11 @@ class RigidBodyClient(object):
         ``/robot1/rigid_body_server``.
     :param timeout: [s] how long to wait for a service when connecting or
         reconnecting.
+    :param reconnect: reconnect once and retry when a connection drops
+        (False: raise at once).
+    :param transport: ``'tcpros'`` (:class:`~diff_rigid_body.tcpros.ServiceConnection`: the
+        request's arrays go to the socket without a copy, the answer lands in one buffer) or
+        ``'rospy'`` (``rospy.ServiceProxy`` with ``numpy_msg`` both ways). Same bytes on the wire.
 
     ``rospy.init_node`` is not required for calls.
     """
@@ -189,11 +112,17 @@ class RigidBodyClient(object):
         'get_vertex_jacobians': GetVertexJacobians,
         'backprop': Backprop,
         'get_vertex_jacobians_compact': GetVertexJacobiansCompact,
+        'inverse_dynamics': InverseDynamics,
+        'forward_dynamics': ForwardDynamics,
     }
 
-    def __init__(self, server='rigid_body_server', timeout=30.0):
+    def __init__(self, server='rigid_body_server', timeout=30.0, reconnect=True, transport='tcpros'):
+        if transport not in ('tcpros', 'rospy'):
+            raise ValueError("transport: 'tcpros' or 'rospy', got %r" % (transport,))
         self.server = rospy.resolve_name(server)
         self.timeout = timeout
+        self.reconnect = reconnect
+        self.transport = transport
         self._proxies = {}
         self._dofs = None  # body name -> d, from get_bodies when first needed
 
@@ -203,7 +132,10 @@ class RigidBodyClient(object):
         if proxy is None:
             resolved = '%s/%s' % (self.server, name)
             rospy.wait_for_service(resolved, timeout=self.timeout)
-            proxy = rospy.ServiceProxy(resolved, _numpy_service(self.SERVICES[name]), persistent=True)
+            if self.transport == 'tcpros':
+                proxy = ServiceConnection(resolved, self.SERVICES[name], self.timeout)
+            else:
+                proxy = rospy.ServiceProxy(resolved, _numpy_service(self.SERVICES[name]), persistent=True)
             self._proxies[name] = proxy
         return proxy
 
@@ -213,21 +145,31 @@ class RigidBodyClient(object):
         if proxy is not None:
             proxy.close()
 
-    def call(self, name, **request):
-        """Calls service ``name`` with the request fields given; returns the
+    def request(self, name, **fields):
+        """The request message of service ``name`` with ``fields``, its numeric arrays flat numpy
+        buffers of their wire types (an array not given is empty)."""
+        return wire_message(numpy_msg(self.SERVICES[name]._request_class), fields)
+
+    def send(self, name, message):
+        """Sends the request ``message`` (from :meth:`request`) to service ``name``; returns the
         response (numpy arrays) or raises :class:`DiffRigidBodyError`."""
-        request_class = self.SERVICES[name]._request_class
-        message = request_class(**request)
         try:
             response = self._proxy(name).call(message)
         except (rospy.ServiceException, rospy.exceptions.TransportException, OSError):
             # The persistent connection dropped (e.g. the node restarted):
             # reconnect once and retry. A second failure propagates.
             self._drop(name)
+            if not self.reconnect:
+                raise
             response = self._proxy(name).call(message)
         if not response.success:
             raise DiffRigidBodyError('%s/%s' % (self.server, name), response.message)
         return response
+
+    def call(self, name, **request):
+        """Calls service ``name`` with the request fields given; returns the
+        response (numpy arrays) or raises :class:`DiffRigidBodyError`."""
+        return self.send(name, self.request(name, **request))
 
     def connect(self, services=None):
         """Opens the persistent connections now (``services``: names, None =
@@ -255,18 +197,12 @@ class RigidBodyClient(object):
         return self._dofs.get(body, 0)
 
     def _configurations(self, body, q):
-        return _configurations(q, lambda: self.dofs(body))
+        return vertex_configurations(q, lambda: self.dofs(body))
 
     # ------------------------------------------------------------------ services
     def bodies(self):
         """The scene: a :data:`Bodies` tuple."""
-        r = self.call('get_bodies')
-        n = len(r.names)
-        return Bodies(r.fixed_frame, list(r.names), np.asarray(r.masses), np.asarray(r.inertias).reshape(n, 3, 3),
-                      np.asarray(r.com_offsets).reshape(n, 3), np.asarray(r.vertex_counts), np.asarray(r.dofs),
-                      _split(r.joint_counts, [Joint(name, lower, upper) for name, lower, upper in
-                                              zip(r.joint_names, r.joint_lower, r.joint_upper)]),
-                      _split(r.link_counts, _links(r)))
+        return bodies_from_response(self.call('get_bodies'))
 
     def get_state(self, bodies=None):
         """dict body name -> x (d,), in the node's order (``bodies`` None = all)."""
@@ -277,7 +213,7 @@ class RigidBodyClient(object):
         """Sets states, all or nothing. ``states``: dict name -> x (d,), or
         pairs (name, x)."""
         items = states.items() if hasattr(states, 'items') else states
-        self.call('set_state', states=[BodyState(name=name, q=_floats(q)) for name, q in items])
+        self.call('set_state', states=[BodyState(name=name, q=floats(q)) for name, q in items])
 
     def mass_matrix(self, bodies=None, q=None, derivatives=False):
         """M(x) of ``bodies`` (None = all), as :data:`MassMatrices`.
@@ -291,23 +227,55 @@ class RigidBodyClient(object):
         bodies' d differ, M and dM are lists with one array per body, without
         the body axis: ``M[i]`` (d_i, d_i) or (K, d_i, d_i).
         """
-        r = self.call('get_mass_matrix', bodies=list(bodies or []), q=_pose(q), derivatives=bool(derivatives))
-        n, dofs = len(r.bodies), [int(d) for d in r.dofs]
-        K = len(r.cos_theta) // n if n else 0
-        batched = (q is not None and np.ndim(q) == 3) or K > 1
-        shape = (K, n) if batched else (n,)
-        cos_theta = np.asarray(r.cos_theta).reshape(shape)
-        if len(set(dofs)) <= 1:
-            d = dofs[0] if dofs else 0
-            M = np.asarray(r.mass_matrices).reshape(shape + (d, d))
-            dM = np.asarray(r.derivatives).reshape(shape + (d, d, d)) if derivatives else None
-            return MassMatrices(list(r.bodies), M, dM, cos_theta)
-        M = _per_body(r.mass_matrices, dofs, K, 2)
-        dM = _per_body(r.derivatives, dofs, K, 3) if derivatives else None
-        if not batched:
-            M = [m[0] for m in M]
-            dM = None if dM is None else [m[0] for m in dM]
-        return MassMatrices(list(r.bodies), M, dM, cos_theta)
+        r = self.call('get_mass_matrix', bodies=list(bodies or []), q=optional_values(q),
+                      derivatives=bool(derivatives))
+        shape = AnswerShape(r, q)
+        return MassMatrices(list(r.bodies), shape.field(r.mass_matrices, 2), shape.field(r.derivatives, 3, derivatives),
+                            shape.per_body_scalars(r.cos_theta))
+
+    def inverse_dynamics(self, q=None, qdot=None, qddot=None, bodies=None, coriolis_matrices=False,
+                         derivatives=False):
+        """tau = M(x) x'' + c(x, x') + g(x) of ``bodies`` (None = all), as
+        :data:`InverseDynamicsResult`; defined everywhere (gimbal lock too).
+
+        ``q`` as for :meth:`mass_matrix` (None = the current state; (K, n, d)
+        or K > 1 concatenations = K configurations); ``qdot`` [rad/s, m/s] and
+        ``qddot`` [rad/s^2, m/s^2] have q's shape (for q None: one
+        configuration), None = zeros. Vectors come as (n, d) or (K, n, d),
+        matrices as (n, d, d) or (K, n, d, d), rows the tau components; lists
+        per body when the bodies' d differ, as for :meth:`mass_matrix`.
+        ``coriolis_matrices`` adds C (c = C x'), ``derivatives`` dtau/dx and
+        dtau/dx' (= 2 C). The node's state is not changed.
+        """
+        r = self.call('inverse_dynamics', bodies=list(bodies or []), q=optional_values(q),
+                      qdot=optional_values(qdot), qddot=optional_values(qddot),
+                      coriolis_matrices=bool(coriolis_matrices), derivatives=bool(derivatives))
+        shape = AnswerShape(r, q)
+        return InverseDynamicsResult(list(r.bodies), shape.field(r.tau, 1), shape.field(r.velocity_terms, 1),
+                                     shape.field(r.gravity_terms, 1),
+                                     shape.field(r.coriolis_matrices, 2, coriolis_matrices),
+                                     shape.field(r.dtau_dq, 2, derivatives), shape.field(r.dtau_dqdot, 2, derivatives),
+                                     shape.per_body_scalars(r.cos_theta))
+
+    def forward_dynamics(self, q=None, qdot=None, tau=None, bodies=None, derivatives=False):
+        """x'' = M(x)^-1 (tau - c(x, x') - g(x)) of ``bodies`` (None = all), as
+        :data:`ForwardDynamicsResult`.
+
+        ``q``, ``qdot`` and the shapes of the answer as for
+        :meth:`inverse_dynamics`; ``tau`` [N m, N] has q's shape, None = zeros
+        (for a free root: (T^T n, f), n the torque about its COM, f the
+        force, fixed-frame axes). ``derivatives`` adds dx''/dx, dx''/dx' and
+        dx''/dtau = M^-1. A configuration where M is singular (gimbal lock, a
+        coordinate that moves no mass) raises :class:`DiffRigidBodyError`
+        naming the body and the configuration. The node's state is not changed.
+        """
+        r = self.call('forward_dynamics', bodies=list(bodies or []), q=optional_values(q),
+                      qdot=optional_values(qdot), tau=optional_values(tau), derivatives=bool(derivatives))
+        shape = AnswerShape(r, q)
+        return ForwardDynamicsResult(list(r.bodies), shape.field(r.qddot, 1),
+                                     shape.field(r.dqddot_dq, 2, derivatives),
+                                     shape.field(r.dqddot_dqdot, 2, derivatives),
+                                     shape.field(r.dqddot_dtau, 2, derivatives), shape.per_body_scalars(r.cos_theta))
 
     def vertex_jacobians(self, body, q=None, vertices=None):
         """positions (N, 3) [m, fixed frame] and J (N, 3, d) = dp/dx of ``body``'s
@@ -317,10 +285,10 @@ class RigidBodyClient(object):
         positions (K, N, 3) and J (K, N, 3, d), each configuration's block the
         same bits as a call with that q alone. The node's state is not changed."""
         K = self._configurations(body, q)
-        r = self.call('get_vertex_jacobians', body=body, vertices=_indices(vertices), q=_pose(q))
+        r = self.call('get_vertex_jacobians', body=body, vertices=indices(vertices), q=optional_values(q))
         N = len(r.positions) // (3 * (K or 1))
         d = len(r.jacobians) // len(r.positions) if len(r.positions) else self.dofs(body)
-        return _blocks(r.positions, K, N), _blocks(r.jacobians, K, N, d)
+        return vertex_blocks(r.positions, K, N), vertex_blocks(r.jacobians, K, N, d)
 
     def vertex_jacobians_compact(self, body, q=None, vertices=None, positions_only=False, single_precision=False):
         """The reduced transport of :meth:`vertex_jacobians`: positions (N, 3) [m]
@@ -330,7 +298,8 @@ class RigidBodyClient(object):
         ``single_precision`` both are float32 (the float64 values rounded).
         A ``q`` of shape (K, d): (K, N, 3) and (K, N, 3, c)."""
         K = self._configurations(body, q)
-        r = self.call('get_vertex_jacobians_compact', body=body, vertices=_indices(vertices), q=_pose(q),
+        r = self.call('get_vertex_jacobians_compact', body=body, vertices=indices(vertices),
+                      q=optional_values(q),
                       positions_only=bool(positions_only), single_precision=bool(single_precision))
         if single_precision:
             positions, jacobians = r.positions_f32, r.rotation_jacobians_f32
@@ -338,9 +307,9 @@ class RigidBodyClient(object):
             positions, jacobians = r.positions, r.rotation_jacobians
         N = len(positions) // (3 * (K or 1))
         if positions_only:
-            return _blocks(positions, K, N), None
+            return vertex_blocks(positions, K, N), None
         c = len(jacobians) // len(positions) if len(positions) else 0
-        return _blocks(positions, K, N), _blocks(jacobians, K, N, c)
+        return vertex_blocks(positions, K, N), vertex_blocks(jacobians, K, N, c)
 
     def positions(self, body, q=None, vertices=None):
         """positions (N, 3) [m] only, or (K, N, 3) for a q of shape (K, d) (the
@@ -356,6 +325,7 @@ class RigidBodyClient(object):
         configuration, (K, d), each row the same bits as a call with that q
         and gradients alone."""
         K = self._configurations(body, q)
-        r = self.call('backprop', body=body, vertices=_indices(vertices), gradients=_floats(gradients), q=_pose(q))
+        r = self.call('backprop', body=body, vertices=indices(vertices), gradients=floats(gradients),
+                      q=optional_values(q))
         gradient = np.asarray(r.gradient)
         return gradient.reshape(-1) if K is None else gradient.reshape(K, -1)

@@ -8,6 +8,10 @@ the CPU; a free body's x is q = (phi, theta, psi, tx, ty, tz), d = 6):
 ``vertex_positions(client, body, q)``    q (K, d) -> p (K, N, 3) [m]; q (d,) -> (N, 3)
 ``mass_matrix(client, body, q)``         q (K, d) -> M (K, d, d); q (d,) -> (d, d)
 ``kinetic_energy(client, body, q, qd)``  q, qdot (K, d) -> E (K,) [J]; (d,) -> ()
+``inverse_dynamics(client, q, qd,        q, qdot, qddot (K, d) -> tau (K, d) [N m, N];
+qdd, body)``                             (d,) -> (d,)
+``forward_dynamics(client, q, qd, tau,   q, qdot, tau (K, d) -> qddot (K, d)
+body)``                                  [rad/s^2, m/s^2]; (d,) -> (d,)
 =======================================  ==========================================
 
 Each forward pass is one service call for all K configurations
@@ -16,6 +20,13 @@ with derivatives); the
 backward pass of :func:`vertex_positions` is one ``backprop`` call with
 grad_output as dL/dp (J is never formed), that of :func:`mass_matrix` is
 dL/dq_j = sum_ab grad_M[a, b] dM[a, b]/dq_j from the dM of the forward call.
+:func:`inverse_dynamics` (tau = M qddot + c + g) asks ``inverse_dynamics``,
+with derivatives (dtau/dq, dtau/dqdot) when q or qdot needs a gradient, and
+``get_mass_matrix`` for M = dtau/dqddot when qddot does;
+:func:`forward_dynamics` (qddot = M^-1 (tau - c - g)) asks
+``forward_dynamics``, with derivatives (dqddot/dq, dqddot/dqdot, M^-1) when
+an input needs a gradient: their backward passes multiply grad_output by
+these Jacobians and call nothing.
 ``per_frame=True`` makes one call per configuration instead (same numbers:
 for comparisons). The node's state is never changed. First derivatives only.
 """
@@ -23,7 +34,8 @@ import numpy as np
 import torch
 from torch.autograd.function import once_differentiable
 
-__all__ = ['vertex_positions', 'mass_matrix', 'kinetic_energy', 'positions_batch', 'backprop_batch']
+__all__ = ['vertex_positions', 'mass_matrix', 'kinetic_energy', 'inverse_dynamics', 'forward_dynamics',
+           'positions_batch', 'backprop_batch', 'inverse_dynamics_batch', 'forward_dynamics_batch']
 
 
 def _numpy(tensor):
@@ -47,6 +59,41 @@ def backprop_batch(client, body, gradients, q, vertices=None, per_frame=False):
     if per_frame:
         return np.stack([client.backprop(body, g, qk, vertices) for g, qk in zip(gradients, q)])
     return client.backprop(body, gradients, q, vertices)
+
+
+def _rows(*arrays):
+    """The K rows of (K, d) arrays as K tuples of (1, 1, d) arrays (one configuration of one body)."""
+    return zip(*(array[:, None, None, :] for array in arrays))
+
+
+def inverse_dynamics_batch(client, body, q, qdot, qddot, derivatives=True, mass_matrix=True, per_frame=False):
+    """tau (K, d), dtau/dq and dtau/dqdot (K, d, d; None without ``derivatives``) and M = dtau/dqddot
+    (K, d, d; None without ``mass_matrix``) of ``body`` at the K rows of q, qdot, qddot (K, d)."""
+    if per_frame:
+        frames = [inverse_dynamics_batch(client, body, *row, derivatives=derivatives, mass_matrix=mass_matrix)
+                  for row in _rows(q, qdot, qddot)]
+        return tuple(None if part[0] is None else np.concatenate(part) for part in zip(*frames))
+    q3 = q.reshape(len(q), 1, -1)  # (K, 1, d): K configurations of one body, batched however small K is
+    answer = client.inverse_dynamics(q3, qdot.reshape(q3.shape), qddot.reshape(q3.shape), [body],
+                                      derivatives=derivatives)
+    M = client.mass_matrix([body], q3).M[:, 0] if mass_matrix else None
+    if not derivatives:
+        return answer.tau[:, 0], None, None, M
+    return answer.tau[:, 0], answer.dtau_dq[:, 0], answer.dtau_dqdot[:, 0], M
+
+
+def forward_dynamics_batch(client, body, q, qdot, tau, derivatives=True, per_frame=False):
+    """qddot (K, d) and dqddot/dq, dqddot/dqdot, dqddot/dtau = M^-1 (K, d, d; None without
+    ``derivatives``) of ``body`` at the K rows of q, qdot, tau (K, d)."""
+    if per_frame:
+        frames = [forward_dynamics_batch(client, body, *row, derivatives=derivatives) for row in _rows(q, qdot, tau)]
+        return tuple(None if part[0] is None else np.concatenate(part) for part in zip(*frames))
+    q3 = q.reshape(len(q), 1, -1)
+    answer = client.forward_dynamics(q3, qdot.reshape(q3.shape), tau.reshape(q3.shape), [body],
+                                     derivatives=derivatives)
+    if not derivatives:
+        return answer.qddot[:, 0], None, None, None
+    return answer.qddot[:, 0], answer.dqddot_dq[:, 0], answer.dqddot_dqdot[:, 0], answer.dqddot_dtau[:, 0]
 
 
 class _VertexPositions(torch.autograd.Function):
@@ -86,6 +133,51 @@ class _MassMatrix(torch.autograd.Function):
         return torch.from_numpy(gradient).to(grad_M.dtype), None, None, None
 
 
+def _vector_jacobian(grad, jacobian, needed):
+    """grad (K, d) times the Jacobians (K, d, d) (rows: output components), as a tensor; None
+    when the input needs no gradient."""
+    if not needed:
+        return None
+    return torch.from_numpy(np.einsum('ka,kab->kb', _numpy(grad), jacobian)).to(grad.dtype)
+
+
+class _InverseDynamics(torch.autograd.Function):
+
+    @staticmethod
+    def forward(ctx, q, qdot, qddot, client, body, per_frame):
+        needs_q, needs_qdot, needs_qddot = ctx.needs_input_grad[:3]
+        tau, ctx.dtau_dq, ctx.dtau_dqdot, ctx.M = inverse_dynamics_batch(
+            client, body, _numpy(q), _numpy(qdot), _numpy(qddot), derivatives=needs_q or needs_qdot,
+            mass_matrix=needs_qddot, per_frame=per_frame)
+        return torch.from_numpy(np.array(tau)).to(q.dtype)
+
+    @staticmethod
+    @once_differentiable
+    def backward(ctx, grad_tau):
+        needs_q, needs_qdot, needs_qddot = ctx.needs_input_grad[:3]
+        return (_vector_jacobian(grad_tau, ctx.dtau_dq, needs_q),
+                _vector_jacobian(grad_tau, ctx.dtau_dqdot, needs_qdot),
+                _vector_jacobian(grad_tau, ctx.M, needs_qddot), None, None, None)
+
+
+class _ForwardDynamics(torch.autograd.Function):
+
+    @staticmethod
+    def forward(ctx, q, qdot, tau, client, body, per_frame):
+        qddot, ctx.dqddot_dq, ctx.dqddot_dqdot, ctx.dqddot_dtau = forward_dynamics_batch(
+            client, body, _numpy(q), _numpy(qdot), _numpy(tau), derivatives=any(ctx.needs_input_grad[:3]),
+            per_frame=per_frame)
+        return torch.from_numpy(np.array(qddot)).to(q.dtype)
+
+    @staticmethod
+    @once_differentiable
+    def backward(ctx, grad_qddot):
+        needs_q, needs_qdot, needs_tau = ctx.needs_input_grad[:3]
+        return (_vector_jacobian(grad_qddot, ctx.dqddot_dq, needs_q),
+                _vector_jacobian(grad_qddot, ctx.dqddot_dqdot, needs_qdot),
+                _vector_jacobian(grad_qddot, ctx.dqddot_dtau, needs_tau), None, None, None)
+
+
 def _batched(q, client, body):
     """(q as (K, d), whether q was a single (d,) configuration); d = ``body``'s dof."""
     d = client.dofs(body)
@@ -117,3 +209,33 @@ def kinetic_energy(client, body, q, qdot, per_frame=False):
     Differentiable in q and qdot."""
     M = mass_matrix(client, body, q, per_frame)
     return 0.5 * torch.einsum('...a,...ab,...b->...', qdot, M, qdot)
+
+
+def _batched_like(q, others, client, body):
+    """q as (K, d) (see _batched) and ``others`` (name -> tensor of q's shape) reshaped alike."""
+    q2, single = _batched(q, client, body)
+    reshaped = []
+    for name, value in others:
+        if value.shape != q.shape:
+            raise ValueError('%s of body %r must have the shape of q, %s, not %s'
+                             % (name, body, tuple(q.shape), tuple(value.shape)))
+        reshaped.append(value.reshape(q2.shape))
+    return q2, reshaped, single
+
+
+def inverse_dynamics(client, q, qdot, qddot, body, per_frame=False):
+    """tau = M(q) qddot + c(q, qdot) + g(q) [N m, N] of ``body``: (K, d) for inputs (K, d), (d,)
+    for (d,). Differentiable in q, qdot and qddot (backward from the same call's dtau/dq,
+    dtau/dqdot, and M = dtau/dqddot from get_mass_matrix)."""
+    q2, (qdot2, qddot2), single = _batched_like(q, (('qdot', qdot), ('qddot', qddot)), client, body)
+    tau = _InverseDynamics.apply(q2, qdot2, qddot2, client, body, per_frame)
+    return tau[0] if single else tau
+
+
+def forward_dynamics(client, q, qdot, tau, body, per_frame=False):
+    """qddot = M(q)^-1 (tau - c(q, qdot) - g(q)) [rad/s^2, m/s^2] of ``body``: (K, d) for inputs
+    (K, d), (d,) for (d,). Differentiable in q, qdot and tau (backward from the same call's
+    dqddot/dq, dqddot/dqdot and dqddot/dtau = M^-1). A singular M raises DiffRigidBodyError."""
+    q2, (qdot2, tau2), single = _batched_like(q, (('qdot', qdot), ('tau', tau)), client, body)
+    qddot = _ForwardDynamics.apply(q2, qdot2, tau2, client, body, per_frame)
+    return qddot[0] if single else qddot

@@ -8,7 +8,6 @@
 #include <geometry_msgs/TransformStamped.h>
 #include <tf2_msgs/TFMessage.h>
 
-#include "diff_rigid_body/articulated_kinematics.h"
 #include "diff_rigid_body/exceptions.h"
 #include "diff_rigid_body/state_file.h"
 
@@ -57,14 +56,15 @@ std::vector<NamedState> toNamedStates(const std::vector<BodyState>& states)
   std::vector<NamedState> named;
   named.reserve(states.size());
   for (const BodyState& state : states)
-    named.push_back({ state.name, Eigen::Map<const Eigen::VectorXd>(state.q.data(), static_cast<Eigen::Index>(state.q.size())) });
+    named.push_back(
+        { state.name, Eigen::Map<const Eigen::VectorXd>(state.q.data(), static_cast<Eigen::Index>(state.q.size())) });
   return named;
 }
 }  // namespace
 
 RigidBodyServer::RigidBodyServer(ros::NodeHandle& nh, ros::NodeHandle& private_nh, Scene scene,
                                  const ServerSettings& settings)
-  : queries_(std::move(scene))
+  : queries_(std::move(scene), settings.gravity)
   , state_file_(settings.state_file)
   , frame_prefix_(settings.frame_prefix)
   , state_(std::make_shared<const SceneState>(initialState(queries_, state_file_)))
@@ -122,21 +122,21 @@ void RigidBodyServer::initOutgoingMessages(const SceneState& state)
 {
   const Scene& scene = queries_.scene();
   first_transform_of_body_.assign(1, 0);
-  for (const SceneBody& body : scene.bodies)
+  for (const BodyModel& body : scene.bodies)
     first_transform_of_body_.push_back(first_transform_of_body_.back() + body.links.size());
   body_transforms_.resize(first_transform_of_body_.back());
   states_message_.header.frame_id = frame_prefix_ + scene.fixed_frame;
   states_message_.states.resize(scene.bodies.size());
   for (std::size_t i = 0; i < scene.bodies.size(); ++i)
   {
-    const SceneBody& body = scene.bodies[i];
+    const BodyModel& body = scene.bodies[i];
     for (std::size_t l = 0; l < body.links.size(); ++l)
     {
       geometry_msgs::TransformStamped& transform = body_transforms_[first_transform_of_body_[i] + l];
       transform.header.frame_id = frame_prefix_ + scene.fixed_frame;
       transform.child_frame_id = frame_prefix_ + body.links[l].name;
     }
-    states_message_.states[i].name = body.body.name;
+    states_message_.states[i].name = body.name;
     writeBodyToOutgoingMessages(i, state[i]);
   }
 }
@@ -151,28 +151,10 @@ void RigidBodyServer::updateOutgoingMessages(const SceneState& previous, const S
 
 void RigidBodyServer::writeBodyToOutgoingMessages(std::size_t body_index, const Eigen::VectorXd& x)
 {
-  const SceneBody& body = queries_.scene().bodies[body_index];
   geometry_msgs::TransformStamped* transforms = &body_transforms_[first_transform_of_body_[body_index]];
-  if (body.articulated)
-  {
-    // Link l: X_fixed_link = X_fixed_segment(x) * X_segment_link.
-    const ArticulatedPose<double> pose = articulatedPose<double>(*body.articulated, x.data());
-    for (std::size_t l = 0; l < body.links.size(); ++l)
-    {
-      const SegmentFrame<double>& frame = pose.frames[body.links[l].segment];
-      Eigen::Isometry3d segment_pose = Eigen::Isometry3d::Identity();
-      segment_pose.linear() = frame.R;
-      segment_pose.translation() = frame.p;
-      setTransform(segment_pose * body.links[l].pose_in_body_link, transforms[l].transform);
-    }
-  }
-  else
-  {
-    // Link l: X_fixed_link = X_fixed_bodylink(q) * X_bodylink_link.
-    const Eigen::Isometry3d link_pose = linkPoseFromState(Vector6<double>(x.head<6>()), body.body.com_offset);
-    for (std::size_t l = 0; l < body.links.size(); ++l)
-      setTransform(link_pose * body.links[l].pose_in_body_link, transforms[l].transform);
-  }
+  queries_.linkPoses(body_index, x, link_poses_);
+  for (std::size_t l = 0; l < link_poses_.size(); ++l)
+    setTransform(link_poses_[l], transforms[l].transform);
   states_message_.states[body_index].q.assign(x.data(), x.data() + x.size());
 }
 
@@ -215,26 +197,21 @@ bool RigidBodyServer::getBodies(GetBodies::Request&, GetBodies::Response& respon
 {
   return serve(response, "get_bodies", [&] {
     response.fixed_frame = frame_prefix_ + queries_.scene().fixed_frame;
-    for (const SceneBody& scene_body : queries_.scene().bodies)
+    for (const BodyModel& body : queries_.scene().bodies)
     {
-      const RigidBody& body = scene_body.body;
+      const Segment& root = body.segments.front();
       response.names.push_back(body.name);
-      response.masses.push_back(body.mass);
-      appendMatrix(body.inertia_body, response.inertias);
-      appendMatrix(body.com_offset, response.com_offsets);
-      response.vertex_counts.push_back(static_cast<std::uint32_t>(scene_body.vertexCount()));
-      response.dofs.push_back(static_cast<std::uint32_t>(scene_body.dofs()));
-      if (const std::shared_ptr<const ArticulatedBody>& tree = scene_body.articulated)
-      {
-        response.joint_counts.push_back(static_cast<std::uint32_t>(tree->joint_names.size()));
-        response.joint_names.insert(response.joint_names.end(), tree->joint_names.begin(), tree->joint_names.end());
-        response.joint_lower.insert(response.joint_lower.end(), tree->joint_lower.begin(), tree->joint_lower.end());
-        response.joint_upper.insert(response.joint_upper.end(), tree->joint_upper.begin(), tree->joint_upper.end());
-      }
-      else
-        response.joint_counts.push_back(0);
-      response.link_counts.push_back(static_cast<std::uint32_t>(scene_body.links.size()));
-      for (const LinkInBody& link : scene_body.links)
+      response.masses.push_back(body.mass());
+      appendMatrix(root.inertia.inertia, response.inertias);
+      appendMatrix(body.rootComOffset(), response.com_offsets);
+      response.vertex_counts.push_back(static_cast<std::uint32_t>(body.vertexCount()));
+      response.dofs.push_back(static_cast<std::uint32_t>(body.coordinates));
+      response.joint_counts.push_back(static_cast<std::uint32_t>(body.joint_names.size()));
+      response.joint_names.insert(response.joint_names.end(), body.joint_names.begin(), body.joint_names.end());
+      response.joint_lower.insert(response.joint_lower.end(), body.joint_lower.begin(), body.joint_lower.end());
+      response.joint_upper.insert(response.joint_upper.end(), body.joint_upper.begin(), body.joint_upper.end());
+      response.link_counts.push_back(static_cast<std::uint32_t>(body.links.size()));
+      for (const LinkInBody& link : body.links)
       {
         response.link_names.push_back(link.name);
         response.link_vertex_counts.push_back(link.new_vertex_count);
@@ -258,7 +235,7 @@ bool RigidBodyServer::getState(GetState::Request& request, GetState::Response& r
     {
       BodyState state;
       state.name = named.name;
-      state.q.assign(named.q.data(), named.q.data() + named.q.size());
+      state.q.assign(named.x.data(), named.x.data() + named.x.size());
       response.states.push_back(std::move(state));
     }
   });
@@ -339,6 +316,40 @@ bool RigidBodyServer::getVertexJacobiansCompact(GetVertexJacobiansCompact::Reque
     else
       queries_.vertexRotationJacobians(*snapshot(), request.body, request.vertices, request.q, request.positions_only,
                                        response.positions, response.rotation_jacobians);
+  });
+}
+
+bool RigidBodyServer::inverseDynamics(InverseDynamics::Request& request, InverseDynamics::Response& response)
+{
+  return serve(response, "inverse_dynamics", [&] {
+    InverseDynamicsAnswer answer;
+    queries_.inverseDynamics(*snapshot(), request.bodies, request.q, request.qdot, request.qddot,
+                             request.coriolis_matrices, request.derivatives, answer);
+    response.bodies = std::move(answer.bodies);
+    response.dofs = std::move(answer.dofs);
+    response.tau = std::move(answer.tau);
+    response.velocity_terms = std::move(answer.velocity_terms);
+    response.gravity_terms = std::move(answer.gravity_terms);
+    response.coriolis_matrices = std::move(answer.coriolis_matrices);
+    response.dtau_dq = std::move(answer.dtau_dq);
+    response.dtau_dqdot = std::move(answer.dtau_dqdot);
+    response.cos_theta = std::move(answer.cos_theta);
+  });
+}
+
+bool RigidBodyServer::forwardDynamics(ForwardDynamics::Request& request, ForwardDynamics::Response& response)
+{
+  return serve(response, "forward_dynamics", [&] {
+    ForwardDynamicsAnswer answer;
+    queries_.forwardDynamics(*snapshot(), request.bodies, request.q, request.qdot, request.tau, request.derivatives,
+                             answer);
+    response.bodies = std::move(answer.bodies);
+    response.dofs = std::move(answer.dofs);
+    response.qddot = std::move(answer.qddot);
+    response.dqddot_dq = std::move(answer.dqddot_dq);
+    response.dqddot_dqdot = std::move(answer.dqddot_dqdot);
+    response.dqddot_dtau = std::move(answer.dqddot_dtau);
+    response.cos_theta = std::move(answer.cos_theta);
   });
 }
 

@@ -59,6 +59,8 @@ struct ServerSettings
   /// reports (tf parent and child, /tf_static, ~states, get_bodies), as
   /// robot_state_publisher's frame_prefix; "" by default.
   std::string frame_prefix;
+  /// ~gravity: gamma in the fixed frame [m/s^2], for the dynamics services.
+  Eigen::Vector3d gravity = standardGravity();
 };
 
 class RigidBodyServer
@@ -83,9 +85,7 @@ private:
   /// Rewrites the transforms and x of the bodies whose x differs (bitwise)
   /// between `previous` and `next`.
   void updateOutgoingMessages(const SceneState& previous, const SceneState& next);
-  /// Body i's link frames from x: a free body's link l at
-  /// X(q) * pose_in_body_link; an articulated body's at
-  /// X_segment(x) * pose_in_body_link, X_segment from articulatedPose.
+  /// Body i's link frames from x (SceneQueries::linkPoses) and its x.
   void writeBodyToOutgoingMessages(std::size_t body_index, const Eigen::VectorXd& x);
   /// Restamps the outgoing messages and publishes them: all body link frames
   /// on /tf in one message (when /tf has a subscriber), and the states on
@@ -104,6 +104,8 @@ private:
   bool backprop(Backprop::Request& request, Backprop::Response& response);
   bool getVertexJacobiansCompact(GetVertexJacobiansCompact::Request& request,
                                  GetVertexJacobiansCompact::Response& response);
+  bool inverseDynamics(InverseDynamics::Request& request, InverseDynamics::Response& response);
+  bool forwardDynamics(ForwardDynamics::Request& request, ForwardDynamics::Response& response);
   bool ping(Ping::Request& request, Ping::Response& response);
   bool echo(Echo::Request& request, Echo::Response& response);
   void onSetStates(const BodyStateArray::ConstPtr& message);
@@ -127,6 +129,7 @@ private:
   /// Body i's links are body_transforms_[first_transform_of_body_[i], first_transform_of_body_[i + 1]).
   std::vector<std::size_t> first_transform_of_body_;
   BodyStateArray states_message_;
+  std::vector<Eigen::Isometry3d> link_poses_;  ///< scratch of writeBodyToOutgoingMessages
 
   tf2_ros::TransformBroadcaster tf_broadcaster_;
   /// A second handle on the broadcaster's /tf publication (roscpp keeps one

@@ -1,6 +1,7 @@
 // rigid_body_server: loads a URDF scene and serves differentiable rigid-body
 // quantities. An unusable description is logged and the node exits with 1;
 // it never half-starts.
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <sstream>
@@ -62,6 +63,19 @@ drb::SceneOptions readSceneOptions(const ros::NodeHandle& private_nh)
   return options;
 }
 
+// ~gravity: three finite numbers [m/s^2], gamma in the fixed frame.
+Eigen::Vector3d readGravity(const ros::NodeHandle& private_nh)
+{
+  std::vector<double> gravity;
+  if (!private_nh.hasParam("gravity"))
+    return drb::standardGravity();
+  if (!private_nh.getParam("gravity", gravity) || gravity.size() != 3 ||
+      !std::all_of(gravity.begin(), gravity.end(), [](double g) { return std::isfinite(g); }))
+    throw drb::SceneDescriptionError("parameter ~gravity: must be a list of three finite numbers [m/s^2], "
+                                     "e.g. [0, 0, -9.81]");
+  return Eigen::Vector3d(gravity[0], gravity[1], gravity[2]);
+}
+
 drb::Scene loadScene(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh)
 {
   const drb::SceneOptions options = readSceneOptions(private_nh);
@@ -96,7 +110,10 @@ int main(int argc, char** argv)
   settings.frame_prefix = private_nh.param<std::string>("frame_prefix", "");
 
   drb::Scene scene;
-  if (!drb::node::runAtStart("cannot load the scene", [&] { scene = loadScene(nh, private_nh); }))
+  if (!drb::node::runAtStart("cannot load the scene", [&] {
+        settings.gravity = readGravity(private_nh);
+        scene = loadScene(nh, private_nh);
+      }))
     return 1;
   // With ~joints: model only planar joints are left unmodelled, which interface.md asks to warn about;
   // with ~joints: free every 1-dof joint is, by request.
@@ -112,8 +129,8 @@ int main(int argc, char** argv)
     ROS_WARN_STREAM("rigid_body_server: " << warning);
 
   std::ostringstream summary;
-  for (const drb::SceneBody& body : scene.bodies)
-    summary << " " << body.body.name << " (" << body.dofs() << " coordinates, " << body.vertexCount() << " vertices)";
+  for (const drb::BodyModel& body : scene.bodies)
+    summary << " " << body.name << " (" << body.coordinates << " coordinates, " << body.vertexCount() << " vertices)";
   ROS_INFO_STREAM("rigid_body_server: serving " << scene.bodies.size() << " bodies in '" << scene.fixed_frame
                                                 << "':" << summary.str());
 

@@ -37,7 +37,7 @@ inline void requireAllFinite(const double* values, std::size_t count, const std:
 inline int findBody(const drb::Scene& scene, const std::string& name)
 {
   for (std::size_t i = 0; i < scene.bodies.size(); ++i)
-    if (scene.bodies[i].body.name == name)
+    if (scene.bodies[i].name == name)
       return static_cast<int>(i);
   return -1;
 }
@@ -48,19 +48,19 @@ inline int findBody(const drb::Scene& scene, const std::string& name)
 inline void requireValidScene(const drb::Scene& scene)
 {
   require(!scene.bodies.empty(), "a loaded scene has no body");
-  for (const drb::SceneBody& scene_body : scene.bodies)
+  for (const drb::BodyModel& body : scene.bodies)
   {
-    const drb::RigidBody& body = scene_body.body;
     const std::string where = "body '" + body.name + "': ";
     // Massless bodies load (with a warning); a massive one has a normal mass.
-    require(std::isfinite(body.mass) && body.mass >= 0.0, where + "mass not finite and >= 0");
-    require(body.mass == 0.0 || std::isnormal(body.mass), where + "subnormal mass");
-    require(body.inertia_body.allFinite(), where + "inertia not finite");
-    require(body.com_offset.allFinite(), where + "COM offset not finite");
+    const double mass = body.mass();
+    require(std::isfinite(mass) && mass >= 0.0, where + "mass not finite and >= 0");
+    require(mass == 0.0 || std::isnormal(mass), where + "subnormal mass");
+    require(body.segments.front().inertia.inertia.allFinite(), where + "inertia not finite");
+    require(body.rootComOffset().allFinite(), where + "COM offset not finite");
     require(body.vertices.allFinite(), where + "vertices not finite");
-    require(scene_body.initial_state.allFinite(), where + "initial state not finite");
-    for (const drb::LinkInBody& link : scene_body.links)
-      require(link.pose_in_body_link.matrix().allFinite(), where + "link pose not finite");
+    require(body.initial_x.allFinite(), where + "initial state not finite");
+    for (const drb::LinkInBody& link : body.links)
+      require(link.pose_in_segment_link.matrix().allFinite(), where + "link pose not finite");
     require(findBody(scene, body.name) >= 0, where + "not found by name");
   }
   for (const drb::StaticLink& link : scene.static_links)

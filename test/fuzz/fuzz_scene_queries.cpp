@@ -133,7 +133,7 @@ void setState(FuzzedDataProvider& in, drb::SceneState& current)
   {
     update.name = fuzzedName(in);
     for (int k = 0; k < 6; ++k)
-      update.q[k] = fuzzedDouble(in);
+      update.x[k] = fuzzedDouble(in);
   }
   drb::SceneState next;
   try
@@ -152,8 +152,8 @@ void setState(FuzzedDataProvider& in, drb::SceneState& current)
     require(index >= 0, "set_state accepted an unknown body");
     require(!updated[index], "set_state accepted a repeated body");
     updated[index] = true;
-    require(next[index].size() == update.q.size() &&
-                std::memcmp(next[index].data(), update.q.data(), sizeof(double) * update.q.size()) == 0,
+    require(next[index].size() == update.x.size() &&
+                std::memcmp(next[index].data(), update.x.data(), sizeof(double) * update.x.size()) == 0,
             "set_state did not store q bit for bit");
   }
   for (std::size_t i = 0; i < next.size(); ++i)

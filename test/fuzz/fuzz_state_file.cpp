@@ -45,7 +45,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   drb_fuzz::require(state.size() == scene().bodies.size(), "parsed state has the wrong size");
   for (std::size_t i = 0; i < state.size(); ++i)
   {
-    drb_fuzz::require(static_cast<std::size_t>(state[i].size()) == scene().bodies[i].dofs(), "parsed x of wrong length");
+    drb_fuzz::require(static_cast<std::size_t>(state[i].size()) == scene().bodies[i].coordinates,
+                      "parsed x of wrong length");
     drb_fuzz::requireAllFinite(state[i].data(), state[i].size(), "parsed q");
   }
   const drb::SceneState again = drb::parseStateFile(drb::formatStateFile(scene(), state), scene());

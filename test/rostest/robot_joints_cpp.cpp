@@ -2,6 +2,10 @@
 // fixed-base body of d = 8 coordinates. Shapes follow d; J matches central differences of the
 // positions the client returns; backprop equals J^T g; dM/dx_j matches central differences of M;
 // set_state/get_state round-trip x bit for bit; a free-body view of the state is refused.
+// inverseDynamics and forwardDynamics: tau = M a + c + g with M from massMatrix, g = tau(x, 0, 0)
+// and c = tau(x, x', 0) - g; FD(ID(a)) = a; dx''/dtau M = I; c = C x'; K configurations in one call
+// equal single calls bit for bit; a wrong length throws ServiceError.
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -20,6 +24,8 @@ using diff_rigid_body_ros::Vector6d;
 constexpr double kStep = 1e-6;          // [rad or m] central differences
 constexpr double kFdTolerance = 1e-6;   // relative to the largest entry
 constexpr double kTolerance = 1e-12;    // relative, products of the same numbers
+// relative, through M^-1: cond(M) eps with the Panda's cond(M) ~ 1e4 (measured 1.6e-14)
+constexpr double kInverseTolerance = 1e-10;
 
 struct Panda
 {
@@ -111,6 +117,89 @@ TEST(CppClientArticulated, StatesOfDofValues)
   EXPECT_THROW(panda.client.setState(panda.body, Vector6d::Zero()), diff_rigid_body_ros::ServiceError)
       << "6 values for an 8-dof body";
   panda.client.setState(before);
+}
+
+/// max |a - b| / max(|a|, |b|).
+double relativeError(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b)
+{
+  return (a - b).cwiseAbs().maxCoeff() / std::max(a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff());
+}
+
+TEST(CppClientArticulated, DynamicsIdentities)
+{
+  Panda panda;
+  const Eigen::Index d = panda.x.size();
+  const Eigen::VectorXd xdot = Eigen::VectorXd::LinSpaced(d, -0.8, 0.9);
+  const Eigen::VectorXd xddot = Eigen::VectorXd::LinSpaced(d, 1.5, -1.2);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(d);
+  const auto id = panda.client.inverseDynamics(panda.body, panda.x, xdot, xddot, /*derivatives=*/true);
+  ASSERT_EQ(id.tau.size(), 1u);
+  ASSERT_EQ(id.tau[0].size(), d);
+  ASSERT_EQ(id.dtau_dq.size(), 1u);
+  EXPECT_EQ(id.dtau_dq[0].rows(), d);
+  EXPECT_TRUE(id.coriolis_matrices.empty()) << "C was not asked for";
+  const Eigen::MatrixXd M = panda.client.massMatrix(panda.body, panda.x);
+  const Eigen::VectorXd g = panda.client.inverseDynamics(panda.body, panda.x, zero, zero).tau[0];
+  const Eigen::VectorXd c = panda.client.inverseDynamics(panda.body, panda.x, xdot, zero).tau[0] - g;
+  EXPECT_LE(relativeError(id.tau[0], M * xddot + c + g), kTolerance) << "tau = M a + c + g";
+  EXPECT_LE(relativeError(id.gravity_terms[0], g), kTolerance) << "g = tau(x, 0, 0)";
+  EXPECT_LE(relativeError(id.velocity_terms[0], c), kTolerance) << "c = tau(x, x', 0) - g";
+
+  const auto fd = panda.client.forwardDynamics(panda.body, panda.x, xdot, id.tau[0], /*derivatives=*/true);
+  ASSERT_EQ(fd.qddot.size(), 1u);
+  EXPECT_LE(relativeError(fd.qddot[0], xddot), kInverseTolerance) << "FD(ID(a)) = a";
+  EXPECT_LE(relativeError(fd.dqddot_dtau[0] * M, Eigen::MatrixXd::Identity(d, d)), kInverseTolerance)
+      << "dx''/dtau M = I";
+
+  const std::vector<double> x(panda.x.data(), panda.x.data() + d), v(xdot.data(), xdot.data() + d);
+  const auto with_c = panda.client.inverseDynamics(x, v, {}, { panda.body }, /*coriolis_matrices=*/true);
+  ASSERT_EQ(with_c.coriolis_matrices.size(), 1u);
+  EXPECT_LE(relativeError(with_c.coriolis_matrices[0] * xdot, c), kTolerance) << "c = C x'";
+}
+
+TEST(CppClientArticulated, DynamicsOfSeveralConfigurations)
+{
+  Panda panda;
+  const Eigen::Index d = panda.x.size();
+  std::vector<double> q, qdot, qddot;
+  for (int k = 0; k < 3; ++k)
+    for (Eigen::Index j = 0; j < d; ++j)
+    {
+      q.push_back(panda.x[j] + 0.05 * k);
+      qdot.push_back(0.1 * (j - k));
+      qddot.push_back(0.2 * (k + 1) - 0.1 * j);
+    }
+  const auto all = panda.client.inverseDynamics(q, qdot, qddot, { panda.body }, true, true);
+  ASSERT_EQ(all.configurations, 3u);
+  ASSERT_EQ(all.tau.size(), 3u);
+  std::vector<double> tau;
+  for (const Eigen::VectorXd& one : all.tau)
+    tau.insert(tau.end(), one.data(), one.data() + one.size());
+  const auto forward = panda.client.forwardDynamics(q, qdot, tau, { panda.body }, true);
+  ASSERT_EQ(forward.qddot.size(), 3u);
+  for (std::size_t k = 0; k < 3; ++k)
+  {
+    const auto slice = [&](const std::vector<double>& values) {
+      return std::vector<double>(values.begin() + k * d, values.begin() + (k + 1) * d);
+    };
+    const std::size_t m = all.index(k, 0);
+    const auto one = panda.client.inverseDynamics(slice(q), slice(qdot), slice(qddot), { panda.body }, true, true);
+    EXPECT_EQ(all.tau[m], one.tau[0]) << "configuration " << k;
+    EXPECT_EQ(all.coriolis_matrices[m], one.coriolis_matrices[0]) << "configuration " << k;
+    EXPECT_EQ(all.dtau_dq[m], one.dtau_dq[0]) << "configuration " << k;
+    EXPECT_EQ(all.dtau_dqdot[m], one.dtau_dqdot[0]) << "configuration " << k;
+    const auto one_forward = panda.client.forwardDynamics(slice(q), slice(qdot), slice(tau), { panda.body }, true);
+    EXPECT_EQ(forward.qddot[m], one_forward.qddot[0]) << "configuration " << k;
+    EXPECT_EQ(forward.dqddot_dq[m], one_forward.dqddot_dq[0]) << "configuration " << k;
+    const std::vector<double> a = slice(qddot);
+    EXPECT_LE(relativeError(forward.qddot[m], Eigen::Map<const Eigen::VectorXd>(a.data(), d)), kInverseTolerance)
+        << "FD(ID(a)) = a, configuration " << k;
+  }
+  EXPECT_THROW(panda.client.forwardDynamics(q, std::vector<double>(q.size() - 1, 0.0)),
+               diff_rigid_body_ros::ServiceError)
+      << "qdot one value short";
+  EXPECT_THROW(panda.client.inverseDynamics(q, {}, {}, { "nope" }), diff_rigid_body_ros::ServiceError)
+      << "an unknown body";
 }
 
 }  // namespace

@@ -190,15 +190,15 @@ TEST_F(Services, AgreesWithCoreLibraryOnTheSameUrdf)
   MaxError order_error("vertices in body frame vs fixture order [m]");
   for (std::size_t i = 0; i < scene.bodies.size(); ++i)
   {
-    const diff_rigid_body::RigidBody& core = scene.bodies[i].body;
+    const diff_rigid_body::BodyModel& core = scene.bodies[i];
     // The node copies these through; they must be bit for bit the same.
     EXPECT_EQ(bodies.names[i], core.name);
-    EXPECT_EQ(bodies.masses[i], core.mass);
+    EXPECT_EQ(bodies.masses[i], core.mass());
     for (int k = 0; k < 3; ++k)
-      EXPECT_EQ(bodies.com_offsets[i][k], core.com_offset[k]);
+      EXPECT_EQ(bodies.com_offsets[i][k], core.rootComOffset()[k]);
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c)
-        EXPECT_EQ(bodies.inertias[i](r, c), core.inertia_body(r, c));
+        EXPECT_EQ(bodies.inertias[i](r, c), core.segments[0].inertia.inertia(r, c));
     ASSERT_EQ(bodies.vertex_counts[i], static_cast<std::uint32_t>(core.vertices.cols()));
 
     // At q = 0, p = p0: the service's positions are the core's body-frame

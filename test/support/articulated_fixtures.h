@@ -166,23 +166,24 @@ inline std::vector<std::pair<std::string, Eigen::VectorXd>> configurations(const
   return out;
 }
 
-/// The model-mode scene of a URDF file, and its body rooted at `root`.
-inline const diff_rigid_body::SceneBody& bodyRootedAt(const diff_rigid_body::Scene& scene, const std::string& root)
+/// The body of a model-mode scene rooted at `root` (a tree: not a free object).
+inline const diff_rigid_body::BodyModel& bodyRootedAt(const diff_rigid_body::Scene& scene, const std::string& root)
 {
   for (const auto& body : scene.bodies)
-    if (body.articulated && body.articulated->segments.front().link == root)
+    if (!body.isFreeObject() && body.segments.front().link == root)
       return body;
   throw std::runtime_error("no articulated body rooted at " + root);
 }
 
-/// A fixture (or the floating tree) loaded in model mode, with its URDF model.
+/// A fixture (or the floating tree) loaded in model mode, with its URDF
+/// model: `model` is the oracle's (articulated_oracles.h), body() the core's.
 struct LoadedBody
 {
   std::string name;
   std::string tip;  ///< chain tip for ChainDynParam, "" for none
   BodyModel model;
-  diff_rigid_body::SceneBody scene_body;
-  const diff_rigid_body::ArticulatedBody& body() const { return *scene_body.articulated; }
+  diff_rigid_body::BodyModel core;
+  const diff_rigid_body::BodyModel& body() const { return core; }
 };
 
 /// The fixed-base fixtures and the floating tree, loaded once.

@@ -1,5 +1,5 @@
 // Independent oracles for articulated bodies (interface.md, "Version 2").
-// Nothing here uses articulated_kinematics.h: the coordinates, joint limits
+// Nothing here uses the core (kinematics.h, crba.h): the coordinates, joint limits
 // and mimic map are read from the URDF (tinyxml2 for document order,
 // urdfdom for the model), link poses are products of Eigen isometries and
 // AngleAxis rotations, and KDL builds its own tree (kdl_parser).

@@ -1,5 +1,5 @@
 // Articulated bodies (interface.md, "Version 2") in the hard cases:
-//   - 256-bit MPFR: articulatedMassMatrix<mpfr::mpreal> at the same x is the
+//   - 256-bit MPFR: crba<mpfr::mpreal> at the same x is the
 //     reference for the double M: the floating tree at pitch pi/2 and
 //     pi/2 +- 1e-k (k = 3, 6, 9), every fixture with its joints at their
 //     limits, stretched straight and at random, and the zero-mass frames
@@ -8,7 +8,7 @@
 //   - the home poses (UR5 all zero, the Panda's SRDF "default"): M is
 //     positive definite;
 //   - a scene of free objects loads in model mode exactly as in free mode
-//     (no articulated body, the same bits).
+//     (free objects, the same bits).
 // The double error is measured in ulps of max|M| (ulp = spacing of doubles
 // at max|M|).
 #include <unsupported/Eigen/MPRealSupport>
@@ -25,14 +25,15 @@
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
-#include "diff_rigid_body/articulated_queries.h"
-#include "diff_rigid_body/mass_matrix.h"
+#include "diff_rigid_body/free_body/mass_matrix.h"
 #include "../support/articulated_fixtures.h"
+#include "../support/body_models.h"
 
 namespace drb = diff_rigid_body;
 using namespace drb_test;
 using namespace drb_test::articulated;
 using mpfr::mpreal;
+using drb_test::core_body::massMatrixAt;
 namespace ub = drb_test::urdf;  // URDF text builders (urdf:: is urdfdom)
 
 namespace
@@ -60,11 +61,11 @@ const LoadedBody& loaded(const std::string& name)
 }
 
 /// |M_double - M_256| / ulp(max|M_256|), the difference taken in 256 bits.
-double mpfrUlps(const drb::ArticulatedBody& body, const Eigen::VectorXd& x)
+double mpfrUlps(const drb::BodyModel& body, const Eigen::VectorXd& x)
 {
-  const Eigen::MatrixXd M = drb::articulatedMassMatrix(body, x.data());
+  const Eigen::MatrixXd M = massMatrixAt(body, x.data());
   const VectorMp x_mp = x.cast<mpreal>();
-  const MatrixMp M_mp = drb::articulatedMassMatrix(body, x_mp.data());
+  const MatrixMp M_mp = massMatrixAt(body, x_mp.data());
   const mpreal err = (M.cast<mpreal>() - M_mp).cwiseAbs().maxCoeff();
   const double scale = M_mp.cwiseAbs().maxCoeff().toDouble();
   return err.toDouble() / ulp(scale);
@@ -96,13 +97,13 @@ TEST(ArticulatedHardCases, FloatingTreeNearGimbalLockMatchesMpfr256)
     {
       Eigen::VectorXd x = x0;
       x[1] = pitch;
-      const Eigen::MatrixXd M = drb::articulatedMassMatrix(b.body(), x.data());
+      const Eigen::MatrixXd M = massMatrixAt(b.body(), x.data());
       ASSERT_TRUE(M.allFinite()) << label << ", pitch " << pitch;
       const double e = mpfrUlps(b.body(), x);
       ulps.update(e);
       ASSERT_LE(e, kMpfrUlps) << label << ", pitch pi/2 offset " << pitch - kHalfPi << ", x = " << row(x);
       // dM/dx of the root angles against the complex step, relative to max(max|dM|, max|M|).
-      const std::vector<Eigen::MatrixXd> dM = drb::articulatedMassMatrixDerivatives(b.body(), x.data());
+      const std::vector<Eigen::MatrixXd> dM = drb_test::core_body::massMatrixDerivativesAt(b.body(), x.data());
       double scale = maxAbs(M);
       for (const auto& d : dM)
         scale = std::max(scale, maxAbs(d));
@@ -110,7 +111,7 @@ TEST(ArticulatedHardCases, FloatingTreeNearGimbalLockMatchesMpfr256)
       {
         Eigen::VectorXcd xc = x.cast<Complex>();
         xc[j] += Complex(0.0, kComplexStepH);
-        const Eigen::MatrixXd dM_cs = drb::articulatedMassMatrix(b.body(), xc.data()).imag() / kComplexStepH;
+        const Eigen::MatrixXd dM_cs = massMatrixAt(b.body(), xc.data()).imag() / kComplexStepH;
         const double e_d = maxAbs(dM[j] - dM_cs) / scale;
         derivative.update(e_d);
         ASSERT_LE(e_d, kComplexStepTol) << label << ", pitch " << pitch << ", d/dx_" << j;
@@ -163,21 +164,22 @@ TEST(ArticulatedHardCases, ZeroMassFramesAddNoMassAndKeepTheirVertices)
     for (const drb::Segment& s : b.body().segments)
     {
       links.push_back(s.link);
-      mass += s.mass_properties.mass;
-      EXPECT_TRUE(s.mass_properties.inertia.allFinite()) << e.fixture << ", segment " << s.link;
+      mass += s.inertia.mass;
+      EXPECT_TRUE(s.inertia.inertia.allFinite()) << e.fixture << ", segment " << s.link;
     }
     EXPECT_EQ(links, e.segment_links) << e.fixture;
-    EXPECT_NEAR(mass, b.scene_body.body.mass, 4 * kEps * mass) << e.fixture;
+    EXPECT_NEAR(mass, b.body().mass(), 4 * kEps * mass) << e.fixture;
   }
   // The massless wrist segment has no mass of its own but moves the hand.
-  const drb::ArticulatedBody& tree = loaded("floating_tree").body();
+  const drb::BodyModel& tree = loaded("floating_tree").body();
   const auto wrist = std::find_if(tree.segments.begin(), tree.segments.end(),
                                   [](const drb::Segment& s) { return s.link == "wrist"; });
   ASSERT_NE(wrist, tree.segments.end());
-  EXPECT_EQ(wrist->mass_properties.mass, 0.0);
-  const Eigen::VectorXd x = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(tree.dofs()));
-  const Eigen::MatrixXd M = drb::articulatedMassMatrix(tree, x.data());
-  EXPECT_GT(M(wrist->coordinate, wrist->coordinate), 0.0) << "the wrist coordinate must move the hand";
+  EXPECT_EQ(wrist->inertia.mass, 0.0);
+  const Eigen::VectorXd x = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(tree.coordinates));
+  const Eigen::MatrixXd M = massMatrixAt(tree, x.data());
+  const int wrist_coordinate = tree.dofs[static_cast<std::size_t>(wrist->first_dof)].coordinate;
+  EXPECT_GT(M(wrist_coordinate, wrist_coordinate), 0.0) << "the wrist coordinate must move the hand";
 }
 
 TEST(ArticulatedHardCases, HomePosesGivePositiveDefiniteMassMatrices)
@@ -198,14 +200,14 @@ TEST(ArticulatedHardCases, HomePosesGivePositiveDefiniteMassMatrices)
   for (const Home& home : homes)
   {
     const LoadedBody& b = loaded(home.fixture);
-    Eigen::VectorXd x = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(b.body().dofs()));
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(b.body().coordinates));
     for (const auto& [name, value] : home.joints)
     {
       const auto it = std::find(b.body().joint_names.begin(), b.body().joint_names.end(), name);
       ASSERT_NE(it, b.body().joint_names.end()) << home.fixture << ": " << name;
       x[it - b.body().joint_names.begin()] = value;
     }
-    const Eigen::MatrixXd M = drb::articulatedMassMatrix(b.body(), x.data());
+    const Eigen::MatrixXd M = massMatrixAt(b.body(), x.data());
     EXPECT_EQ(maxAbs(M - M.transpose()), 0.0) << home.fixture << ": M is not symmetric\n" << M;
     const Eigen::LLT<Eigen::MatrixXd> llt(M);
     EXPECT_EQ(llt.info(), Eigen::Success) << home.fixture << ": Cholesky fails at x = " << row(x) << "\nM =\n" << M;
@@ -236,24 +238,26 @@ TEST(ArticulatedHardCases, FreeObjectsLoadInModelModeAsInFreeMode)
     ASSERT_EQ(model.bodies.size(), free.bodies.size());
     for (std::size_t i = 0; i < model.bodies.size(); ++i)
     {
-      const drb::SceneBody& m = model.bodies[i];
-      const drb::SceneBody& f = free.bodies[i];
-      const std::string where = "body " + m.body.name;
-      EXPECT_EQ(m.articulated, nullptr) << where;
-      EXPECT_EQ(m.body.name, f.body.name);
-      EXPECT_EQ(m.dofs(), 6u) << where;
-      EXPECT_EQ(m.body.mass, f.body.mass) << where;
-      EXPECT_EQ(maxAbs(m.body.inertia_body - f.body.inertia_body), 0.0) << where;
-      EXPECT_EQ(maxAbs(m.body.com_offset - f.body.com_offset), 0.0) << where;
-      ASSERT_EQ(m.body.vertices.cols(), f.body.vertices.cols()) << where;
-      EXPECT_EQ(maxAbs(m.body.vertices - f.body.vertices), 0.0) << where;
-      ASSERT_EQ(m.initial_state.size(), f.initial_state.size()) << where;
-      EXPECT_EQ(maxAbs(m.initial_state - f.initial_state), 0.0) << where;
+      const drb::BodyModel& m = model.bodies[i];
+      const drb::BodyModel& f = free.bodies[i];
+      const std::string where = "body " + m.name;
+      EXPECT_TRUE(m.isFreeObject()) << where;
+      EXPECT_EQ(m.name, f.name);
+      EXPECT_EQ(m.coordinates, 6u) << where;
+      EXPECT_EQ(m.mass(), f.mass()) << where;
+      const Eigen::Matrix3d& m_inertia = m.segments[0].inertia.inertia;
+      const Eigen::Matrix3d& f_inertia = f.segments[0].inertia.inertia;
+      EXPECT_EQ(maxAbs(m_inertia - f_inertia), 0.0) << where;
+      EXPECT_EQ(maxAbs(m.rootComOffset() - f.rootComOffset()), 0.0) << where;
+      ASSERT_EQ(m.vertices.cols(), f.vertices.cols()) << where;
+      EXPECT_EQ(maxAbs(m.vertices - f.vertices), 0.0) << where;
+      ASSERT_EQ(m.initial_x.size(), f.initial_x.size()) << where;
+      EXPECT_EQ(maxAbs(m.initial_x - f.initial_x), 0.0) << where;
       for (int s = 0; s < 20; ++s)
       {
-        const Vector6<double> q = s == 0 ? Vector6<double>(m.initial_state) : rng.state();
-        const Matrix6<double> M_model = drb::massMatrix(q, m.body.mass, m.body.inertia_body);
-        const Matrix6<double> M_free = drb::massMatrix(q, f.body.mass, f.body.inertia_body);
+        const Vector6<double> q = s == 0 ? Vector6<double>(m.initial_x) : rng.state();
+        const Matrix6<double> M_model = drb::massMatrix(q, m.mass(), m_inertia);
+        const Matrix6<double> M_free = drb::massMatrix(q, f.mass(), f_inertia);
         ASSERT_EQ(maxAbs(M_model - M_free), 0.0) << where << ", q = " << q.transpose();
       }
     }

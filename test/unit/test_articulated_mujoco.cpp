@@ -31,8 +31,8 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
-#include "diff_rigid_body/articulated_kinematics.h"
 #include "../support/articulated_fixtures.h"
+#include "../support/body_models.h"
 #include "../support/mujoco_model.h"
 
 namespace drb = diff_rigid_body;
@@ -159,7 +159,7 @@ Eigen::MatrixXd qvelMap(const mujoco::Model& mj, const BodyModel& b, const Eigen
 }
 
 /// max|A^T M_mj A - M| / max|M| over `xs`, asserting each against `tol`.
-double compareMassMatrices(const drb::ArticulatedBody& body, const BodyModel& model, mujoco::Model& mj,
+double compareMassMatrices(const drb::BodyModel& body, const BodyModel& model, mujoco::Model& mj,
                            const std::vector<std::pair<std::string, Eigen::VectorXd>>& xs, double tol,
                            const char* why)
 {
@@ -170,7 +170,7 @@ double compareMassMatrices(const drb::ArticulatedBody& body, const BodyModel& mo
     Eigen::Map<Eigen::VectorXd>(mj.data().qpos, mj.model().nq) = qpos;
     const Eigen::MatrixXd A = qvelMap(mj, model, x);
     const Eigen::MatrixXd M_mj = A.transpose() * mj.massMatrix() * A;
-    const Eigen::MatrixXd M = drb::articulatedMassMatrix(body, x.data());
+    const Eigen::MatrixXd M = drb_test::core_body::massMatrixAt(body, x.data());
     const double e = maxAbs(M - M_mj) / maxAbs(M);
     err.update(e);
     EXPECT_LE(e, tol) << body.name << ", " << label << ": A^T M_mujoco A differs from M by more than " << why
@@ -182,10 +182,10 @@ double compareMassMatrices(const drb::ArticulatedBody& body, const BodyModel& mo
 /// A copy of `body` with each segment's inertia about its COM replaced by
 /// MuJoCo's compiled one: body_iquat diag(body_inertia) body_iquat^T, the
 /// segment matched by its link's name (MuJoCo fuses the same links).
-drb::ArticulatedBody withMujocoInertias(const drb::ArticulatedBody& body, const mujoco::Model& mj)
+drb::BodyModel withMujocoInertias(const drb::BodyModel& body, const mujoco::Model& mj)
 {
   const mjModel& m = mj.model();
-  drb::ArticulatedBody copy = body;
+  drb::BodyModel copy = body;
   for (drb::Segment& s : copy.segments)
   {
     const int id = mj.body(s.link);
@@ -193,7 +193,7 @@ drb::ArticulatedBody withMujocoInertias(const drb::ArticulatedBody& body, const 
       throw std::runtime_error("MuJoCo has no body " + s.link);
     const mjtNum* q = m.body_iquat + 4 * id;
     const Eigen::Matrix3d Ri = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).toRotationMatrix();
-    s.mass_properties.inertia = Ri * Eigen::Vector3d(m.body_inertia + 3 * id).asDiagonal() * Ri.transpose();
+    s.inertia.inertia = Ri * Eigen::Vector3d(m.body_inertia + 3 * id).asDiagonal() * Ri.transpose();
   }
   return copy;
 }
@@ -228,10 +228,11 @@ TEST(ArticulatedMujoco, FloatingTreeRootIsAFreeJointOnTheTorsoLinkFrame)
   EXPECT_EQ(m.nv, 6 + static_cast<int>(b.model.drives.size()));
   // The torso body: torso and head fused; its frame is the torso link frame
   // iff its COM there is the one we compute.
-  const drb::MassProperties& ours = b.body().segments.front().mass_properties;
+  const drb::MassProperties& ours = b.body().segments.front().inertia;
+  const Eigen::Vector3d our_com = b.body().rootComOffset();
   EXPECT_NEAR(m.body_mass[root], ours.mass, 4 * kEps * ours.mass) << "torso + head mass";
-  EXPECT_LE((rootCom(mj) - ours.com).norm(), 4 * kEps) << "root COM in the torso link frame: MuJoCo "
-                                                         << row(rootCom(mj)) << ", ours " << row(ours.com);
+  EXPECT_LE((rootCom(mj) - our_com).norm(), 4 * kEps) << "root COM in the torso link frame: MuJoCo "
+                                                        << row(rootCom(mj)) << ", ours " << row(our_com);
 }
 
 TEST(ArticulatedMujoco, QvelMapIsTheDerivativeOfMujocosQpos)

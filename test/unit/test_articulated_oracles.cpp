@@ -20,16 +20,17 @@
 
 #include <gtest/gtest.h>
 
-#include "diff_rigid_body/articulated_queries.h"
 #include "../support/articulated_fixtures.h"
+#include "../support/body_models.h"
 
 namespace drb = diff_rigid_body;
 using namespace drb_test;
 using namespace drb_test::articulated;
+using drb_test::core_body::massMatrixAt;
 
 namespace
 {
-// KDL (double) vs articulatedMassMatrix (double): two O(depth) sums of
+// KDL (double) vs crba (double): two O(depth) sums of
 // rounded products; each is a few eps of max|M| from the exact M.
 // Measured: 3.7 eps (RNE, Panda), 4.3 eps (ChainDynParam). 16 eps.
 constexpr double kKdlTol = 16 * kEps;
@@ -49,9 +50,9 @@ constexpr double kPositionTol = 8 * kEps;
 
 using MatrixXc = Eigen::Matrix<Complex, Eigen::Dynamic, Eigen::Dynamic>;
 
-Eigen::MatrixXd massMatrix(const drb::ArticulatedBody& body, const Eigen::VectorXd& x)
+Eigen::MatrixXd massMatrix(const drb::BodyModel& body, const Eigen::VectorXd& x)
 {
-  return drb::articulatedMassMatrix(body, x.data());
+  return massMatrixAt(body, x.data());
 }
 
 /// x + i h e_j.
@@ -71,7 +72,7 @@ Eigen::VectorXd randomVector(Random& rng, Eigen::Index n)
 }
 
 /// Every k-th vertex of the body (and its last), so that each segment is sampled.
-std::vector<std::uint32_t> sampledVertices(const drb::ArticulatedBody& body, std::uint32_t k)
+std::vector<std::uint32_t> sampledVertices(const drb::BodyModel& body, std::uint32_t k)
 {
   std::vector<std::uint32_t> vertices;
   const auto n = static_cast<std::uint32_t>(body.vertices.cols());
@@ -88,16 +89,16 @@ TEST(ArticulatedOracles, CoordinatesAreTheUrdfJointsInDocumentOrder)
 {
   for (const LoadedBody& b : loadedBodies())
   {
-    const drb::ArticulatedBody& body = b.body();
-    EXPECT_EQ(body.floating_root, b.model.floating_root) << b.name;
+    const drb::BodyModel& body = b.body();
+    EXPECT_EQ(body.hasFreeRoot(), b.model.floating_root) << b.name;
     EXPECT_EQ(body.joint_names, b.model.joint_names) << b.name;
     EXPECT_EQ(body.joint_lower, b.model.lower) << b.name;
     EXPECT_EQ(body.joint_upper, b.model.upper) << b.name;
-    ASSERT_EQ(body.dofs(), b.model.dofs()) << b.name;
+    ASSERT_EQ(body.coordinates, b.model.dofs()) << b.name;
     double mass = 0;
     for (const auto& link : b.model.links)
       mass += linkMass(*link).mass;
-    EXPECT_NEAR(b.scene_body.body.mass, mass, 4 * kEps * mass) << b.name << ": total mass";
+    EXPECT_NEAR(body.mass(), mass, 4 * kEps * mass) << b.name << ": total mass";
   }
 }
 
@@ -189,15 +190,15 @@ TEST(ArticulatedOracles, MassMatrixDerivativesMatchComplexStep)
     MaxTracker err;
     for (const auto& [label, x] : configurations(b.model, rng, 10))
     {
-      const std::vector<Eigen::MatrixXd> dM = drb::articulatedMassMatrixDerivatives(b.body(), x.data());
-      ASSERT_EQ(dM.size(), b.body().dofs()) << b.name;
+      const std::vector<Eigen::MatrixXd> dM = drb_test::core_body::massMatrixDerivativesAt(b.body(), x.data());
+      ASSERT_EQ(dM.size(), b.body().coordinates) << b.name;
       double scale = 0;
       for (const auto& d : dM)
         scale = std::max(scale, maxAbs(d));
       for (Eigen::Index j = 0; j < x.size(); ++j)
       {
         const Eigen::VectorXcd xc = complexStepped(x, j);
-        const MatrixXc Mc = drb::articulatedMassMatrix(b.body(), xc.data());
+        const MatrixXc Mc = massMatrixAt(b.body(), xc.data());
         const Eigen::MatrixXd dM_cs = Mc.imag() / kComplexStepH;
         // Relative to the larger of max|dM| over all j and max|M| (the
         // pendulums' M does not depend on their first joint: dM/dx_0 = 0).
@@ -216,16 +217,15 @@ TEST(ArticulatedOracles, VertexJacobiansMatchComplexStepAndForwardKinematics)
   Random rng(1205);
   for (const LoadedBody& b : loadedBodies())
   {
-    const drb::ArticulatedBody& body = b.body();
+    const drb::BodyModel& body = b.body();
     const std::vector<std::uint32_t> vertices = sampledVertices(body, 37);
     ASSERT_GT(vertices.size(), 0u) << b.name;
-    const Eigen::Index n = static_cast<Eigen::Index>(body.dofs()), nv = static_cast<Eigen::Index>(vertices.size());
+    const Eigen::Index n = static_cast<Eigen::Index>(body.coordinates), nv = static_cast<Eigen::Index>(vertices.size());
     MaxTracker err_J, err_p;
     for (const auto& [label, x] : configurations(b.model, rng, 5))
     {
       std::vector<double> positions(3 * nv), jacobians(3 * nv * n);
-      drb::articulatedVertexJacobians(body, drb::articulatedPose(body, x.data()), vertices, {}, positions.data(),
-                                      jacobians.data());
+      drb_test::core_body::vertexJacobiansAt(body, false, vertices, x.data(), positions.data(), jacobians.data());
       // Positions: the link poses of the independent forward kinematics.
       std::map<std::string, Eigen::Isometry3d> link_pose;
       const auto poses = linkPoses(b.model, x);
@@ -234,20 +234,22 @@ TEST(ArticulatedOracles, VertexJacobiansMatchComplexStepAndForwardKinematics)
       for (Eigen::Index i = 0; i < nv; ++i)
       {
         const std::uint32_t v = vertices[i];
-        const Eigen::Vector3d p = link_pose.at(body.segments[body.segmentOfVertex(v)].link) * body.vertices.col(v);
+        const Eigen::Vector3d p =
+            link_pose.at(body.segments[body.segmentOfVertex(v)].link) * drb_test::core_body::vertexInLinkFrame(body, v);
         const double e = (Eigen::Map<const Eigen::Vector3d>(&positions[3 * i]) - p).cwiseAbs().maxCoeff() /
                          std::max(1.0, p.cwiseAbs().maxCoeff());
         err_p.update(e);
         ASSERT_LE(e, kPositionTol) << b.name << ", " << label << ", vertex " << v << ", x = " << row(x);
       }
-      // Jacobians: column j by the complex step of articulatedPose<complex>.
+      // Jacobians: column j by the complex step of forwardKinematics<complex>.
       Eigen::MatrixXd J_cs(3 * nv, n);
       for (Eigen::Index j = 0; j < n; ++j)
       {
         const Eigen::VectorXcd xc = complexStepped(x, j);
-        const drb::ArticulatedPose<Complex> pose = drb::articulatedPose(body, xc.data());
+        const drb::BodyWorkspace<Complex> pose = drb_test::core_body::kinematicsAt(body, xc.data());
         for (Eigen::Index i = 0; i < nv; ++i)
-          J_cs.block(3 * i, j, 3, 1) = drb::articulatedVertexPosition(body, pose, vertices[i]).imag() / kComplexStepH;
+          J_cs.block(3 * i, j, 3, 1) =
+              drb_test::core_body::vertexPosition(body, pose, vertices[i]).imag() / kComplexStepH;
       }
       const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J(
           jacobians.data(), 3 * nv, n);
@@ -259,11 +261,15 @@ TEST(ArticulatedOracles, VertexJacobiansMatchComplexStepAndForwardKinematics)
       // translation columns): the same bits as those columns of J.
       std::vector<int> columns;
       for (int c = 0; c < n; ++c)
-        if (!body.floating_root || c < 3 || c > 5)
+        if (!body.hasFreeRoot() || c < 3 || c > 5)
           columns.push_back(c);
+      const drb::JacobianColumns compact_columns = drb::JacobianColumns::compact(body);
+      ASSERT_EQ(compact_columns.width, columns.size()) << b.name;
+      for (std::size_t c = 0; c < columns.size(); ++c)
+        ASSERT_EQ(compact_columns.of_coordinate[columns[c]], static_cast<int>(c))
+            << b.name << ", column " << columns[c];
       std::vector<double> compact(3 * nv * columns.size()), unused(3 * nv);
-      drb::articulatedVertexJacobians(body, drb::articulatedPose(body, x.data()), vertices, columns, unused.data(),
-                                      compact.data());
+      drb_test::core_body::vertexJacobiansAt(body, true, vertices, x.data(), unused.data(), compact.data());
       for (Eigen::Index i = 0; i < 3 * nv; ++i)
         for (std::size_t c = 0; c < columns.size(); ++c)
           ASSERT_EQ(compact[i * columns.size() + c], J(i, columns[c]))
@@ -271,7 +277,7 @@ TEST(ArticulatedOracles, VertexJacobiansMatchComplexStepAndForwardKinematics)
       // Backprop: sum_v J_v^T g_v with the complex-step J.
       const Eigen::VectorXd g = randomVector(rng, 3 * nv);
       Eigen::VectorXd grad(n);
-      drb::articulatedBackprop(body, drb::articulatedPose(body, x.data()), vertices, g.data(), grad.data());
+      drb_test::core_body::backpropAt(body, vertices, g.data(), x.data(), grad.data());
       const Eigen::VectorXd expected = J_cs.transpose() * g;
       const double scale = (J_cs.cwiseAbs().transpose() * g.cwiseAbs()).maxCoeff();
       const double e_b = maxAbs(grad - expected) / scale;

@@ -7,10 +7,10 @@
 
 #include <gtest/gtest.h>
 
-#include "diff_rigid_body/articulated_queries.h"
 #include "diff_rigid_body/exceptions.h"
 #include "diff_rigid_body/scene_queries.h"
 #include "diff_rigid_body/urdf_scene.h"
+#include "../support/body_models.h"
 #include "../support/expect_throws.h"
 #include "../support/urdf_builders.h"
 
@@ -52,13 +52,13 @@ TEST(ArticulatedScene, TwoLinkArmMatchesTheClosedForm)
                                             "<origin xyz=\"" + std::to_string(l1) + " 0 0\"/>", "0 0 1"));
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
   ASSERT_EQ(scene.bodies.size(), 1u);
-  ASSERT_TRUE(scene.bodies[0].articulated);
-  const drb::ArticulatedBody& arm = *scene.bodies[0].articulated;
-  ASSERT_EQ(arm.dofs(), 2u);
+  ASSERT_FALSE(scene.bodies[0].isFreeObject());
+  const drb::BodyModel& arm = scene.bodies[0];
+  ASSERT_EQ(arm.coordinates, 2u);
   for (const double x2 : { 0.0, 0.7, -1.4, 2.0 })
   {
     const double x[2] = { 0.3, x2 };
-    const Eigen::MatrixXd M = drb::articulatedMassMatrix(arm, x);
+    const Eigen::MatrixXd M = drb_test::core_body::massMatrixAt(arm, x);
     const double M11 = I1 + I2 + m1 * c1 * c1 + m2 * (l1 * l1 + c2 * c2 + 2 * l1 * c2 * std::cos(x2));
     const double M12 = I2 + m2 * (c2 * c2 + l1 * c2 * std::cos(x2));
     const double M22 = I2 + m2 * c2 * c2;
@@ -81,30 +81,30 @@ TEST(ArticulatedScene, FixedBaseTreeHasItsJointsInDocumentOrderWithLimits)
             joint("fixed", "a", "tool", "<origin xyz=\"0.5 0 0\"/>"));
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
   ASSERT_EQ(scene.bodies.size(), 1u);
-  const drb::SceneBody& body = scene.bodies[0];
-  ASSERT_TRUE(body.articulated);
-  const drb::ArticulatedBody& tree = *body.articulated;
-  EXPECT_EQ(body.body.name, "base");
-  EXPECT_FALSE(tree.floating_root);
+  const drb::BodyModel& body = scene.bodies[0];
+  ASSERT_FALSE(body.isFreeObject());
+  const drb::BodyModel& tree = body;
+  EXPECT_EQ(body.name, "base");
+  EXPECT_FALSE(tree.hasFreeRoot());
   EXPECT_EQ(tree.joint_names, (std::vector<std::string>{ "b_joint", "base_joint", "a_joint" }));
   EXPECT_EQ(tree.joint_lower, (std::vector<double>{ -1.5, -std::numeric_limits<double>::infinity(), -1.5 }));
   EXPECT_EQ(tree.joint_upper, (std::vector<double>{ 2, std::numeric_limits<double>::infinity(), 2 }));
-  EXPECT_EQ(body.initial_state, Eigen::VectorXd::Zero(3));
-  EXPECT_DOUBLE_EQ(body.body.mass, 3.5);
+  EXPECT_EQ(body.initial_x, Eigen::VectorXd::Zero(3));
+  EXPECT_DOUBLE_EQ(body.mass(), 3.5);
   // Segments: parents first, then children in link document order (a before b).
   ASSERT_EQ(tree.segments.size(), 3u);
   EXPECT_EQ(tree.segments[0].link, "base");
   EXPECT_EQ(tree.segments[1].link, "a");
   EXPECT_EQ(tree.segments[2].link, "b");
-  EXPECT_EQ(tree.segments[1].coordinate, 2);
-  EXPECT_EQ(tree.segments[2].coordinate, 0);
-  EXPECT_EQ(tree.segments[2].motion, drb::JointMotion::Prismatic);
+  EXPECT_EQ(tree.dofs[tree.segments[1].first_dof].coordinate, 2);
+  EXPECT_EQ(tree.dofs[tree.segments[2].first_dof].coordinate, 0);
+  EXPECT_EQ(tree.segments[2].joint_type, drb::JointType::Prismatic);
   EXPECT_TRUE(tree.segments[2].axis.isApprox(Eigen::Vector3d::UnitZ())) << "the axis is normalised";
   // The tool is merged into segment a, whose mass it adds to.
   ASSERT_EQ(body.links.size(), 4u);
   EXPECT_EQ(body.links[2].name, "tool");
   EXPECT_EQ(body.links[2].segment, 1u);
-  EXPECT_DOUBLE_EQ(tree.segments[1].mass_properties.mass, 1.5);
+  EXPECT_DOUBLE_EQ(tree.segments[1].inertia.mass, 1.5);
   // Each segment's box corners are contiguous, in segment order (a has the tool's too).
   EXPECT_EQ(tree.segments[1].vertex_begin, 8u);
   EXPECT_EQ(tree.segments[1].vertex_count, 16u);
@@ -116,9 +116,9 @@ TEST(ArticulatedScene, FixedBaseTreeHasItsJointsInDocumentOrderWithLimits)
 
   // Joint values move the links: b slides 2 along z, a turns about y at (1, 0, 1).
   const double x[3] = { 0.25, 0.0, M_PI / 2 };
-  const drb::ArticulatedPose<double> pose = drb::articulatedPose(tree, x);
-  EXPECT_TRUE(pose.frames[2].p.isApprox(Eigen::Vector3d(0, 1, 1.25), 1e-15));
-  const Eigen::Vector3d tool_tip = pose.frames[1].R * Eigen::Vector3d(0.5, 0, 0) + pose.frames[1].p;
+  const drb::BodyWorkspace<double> pose = drb_test::core_body::kinematicsAt(tree, x);
+  EXPECT_TRUE(pose.p[2].isApprox(Eigen::Vector3d(0, 1, 1.25), 1e-15));
+  const Eigen::Vector3d tool_tip = pose.R[1] * Eigen::Vector3d(0.5, 0, 0) + pose.p[1];
   EXPECT_NEAR((tool_tip - Eigen::Vector3d(1, 0, 0.5)).norm(), 0.0, 1e-15);
 }
 
@@ -131,15 +131,15 @@ TEST(ArticulatedScene, MimicJointFollowsItsMasterAndAddsNoCoordinate)
       oneDofJoint("right_joint", "prismatic", "palm", "right", "", "0 -1 0",
                   "<mimic joint=\"left_joint\" multiplier=\"2\" offset=\"0.01\"/>"));
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
-  const drb::ArticulatedBody& hand = *scene.bodies.at(0).articulated;
+  const drb::BodyModel& hand = scene.bodies.at(0);
   EXPECT_EQ(hand.joint_names, (std::vector<std::string>{ "palm_joint", "left_joint" }));
   ASSERT_EQ(hand.segments.size(), 3u);
-  EXPECT_EQ(hand.segments[2].coordinate, 1);
-  EXPECT_EQ(hand.segments[2].multiplier, 2.0);
+  EXPECT_EQ(hand.dofs[hand.segments[2].first_dof].coordinate, 1);
+  EXPECT_EQ(hand.dofs[hand.segments[2].first_dof].multiplier, 2.0);
   EXPECT_EQ(hand.segments[2].offset, 0.01);
   const double x[2] = { 0.0, 0.02 };
-  const drb::ArticulatedPose<double> pose = drb::articulatedPose(hand, x);
-  EXPECT_NEAR(pose.frames[2].p.y(), -(2 * 0.02 + 0.01), 1e-17);
+  const drb::BodyWorkspace<double> pose = drb_test::core_body::kinematicsAt(hand, x);
+  EXPECT_NEAR(pose.p[2].y(), -(2 * 0.02 + 0.01), 1e-17);
 }
 
 TEST(ArticulatedScene, FloatingRootCarriesItsJointsAndAFloatingJointBelowStartsANewBody)
@@ -151,16 +151,16 @@ TEST(ArticulatedScene, FloatingRootCarriesItsJointsAndAFloatingJointBelowStartsA
             floatingJoint("ball", "", "leg"));
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
   ASSERT_EQ(scene.bodies.size(), 2u);
-  const drb::SceneBody& torso = scene.bodies[0];
-  ASSERT_TRUE(torso.articulated);
-  EXPECT_TRUE(torso.articulated->floating_root);
-  EXPECT_EQ(torso.dofs(), 7u);
-  EXPECT_NEAR(torso.initial_state[0], 0.1, 1e-15);
-  EXPECT_NEAR(torso.initial_state[1], 0.2, 1e-15);
-  EXPECT_NEAR(torso.initial_state[2], 0.3, 1e-15);
-  EXPECT_EQ(torso.initial_state[6], 0.0);
-  EXPECT_EQ(scene.bodies[1].body.name, "ball");
-  EXPECT_FALSE(scene.bodies[1].articulated) << "a floating body without joints is a version-1 free body";
+  const drb::BodyModel& torso = scene.bodies[0];
+  ASSERT_FALSE(torso.isFreeObject());
+  EXPECT_TRUE(torso.hasFreeRoot());
+  EXPECT_EQ(torso.coordinates, 7u);
+  EXPECT_NEAR(torso.initial_x[0], 0.1, 1e-15);
+  EXPECT_NEAR(torso.initial_x[1], 0.2, 1e-15);
+  EXPECT_NEAR(torso.initial_x[2], 0.3, 1e-15);
+  EXPECT_EQ(torso.initial_x[6], 0.0);
+  EXPECT_EQ(scene.bodies[1].name, "ball");
+  EXPECT_TRUE(scene.bodies[1].isFreeObject()) << "a floating body without joints is a version-1 free body";
 }
 
 TEST(ArticulatedScene, PlanarJointMakesAFreeBodyWithANote)
@@ -168,7 +168,7 @@ TEST(ArticulatedScene, PlanarJointMakesAFreeBodyWithANote)
   const std::string xml = robot(rodLink("puck", 1, 0, 0.1) + oneDofJoint("slide", "planar", "world", "puck", "", "0 0 1"));
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
   ASSERT_EQ(scene.bodies.size(), 1u);
-  EXPECT_FALSE(scene.bodies[0].articulated);
+  EXPECT_TRUE(scene.bodies[0].isFreeObject());
   ASSERT_EQ(scene.unmodelled_joints.size(), 1u);
   EXPECT_NE(scene.unmodelled_joints[0].find("'slide' (planar)"), std::string::npos) << scene.unmodelled_joints[0];
 }
@@ -183,11 +183,11 @@ TEST(ArticulatedScene, FreeObjectsLoadAsInVersionOne)
   ASSERT_EQ(model.bodies.size(), v1.bodies.size());
   for (std::size_t i = 0; i < v1.bodies.size(); ++i)
   {
-    EXPECT_FALSE(model.bodies[i].articulated);
-    EXPECT_EQ(model.bodies[i].initial_state, v1.bodies[i].initial_state);
-    EXPECT_EQ(model.bodies[i].body.vertices, v1.bodies[i].body.vertices);
-    EXPECT_EQ(model.bodies[i].body.inertia_body, v1.bodies[i].body.inertia_body);
-    EXPECT_EQ(model.bodies[i].body.com_offset, v1.bodies[i].body.com_offset);
+    EXPECT_TRUE(model.bodies[i].isFreeObject());
+    EXPECT_EQ(model.bodies[i].initial_x, v1.bodies[i].initial_x);
+    EXPECT_EQ(model.bodies[i].vertices, v1.bodies[i].vertices);
+    EXPECT_EQ(model.bodies[i].segments[0].inertia.inertia, v1.bodies[i].segments[0].inertia.inertia);
+    EXPECT_EQ(model.bodies[i].rootComOffset(), v1.bodies[i].rootComOffset());
   }
 }
 
@@ -222,11 +222,10 @@ TEST(ArticulatedScene, AllVertexPathsAgreeWithIndexListsAndJTransposeG)
             oneDofJoint("hip", "revolute", "torso", "leg", "<origin xyz=\"0 0 -0.2\"/>", "0 1 0") +
             oneDofJoint("ankle", "prismatic", "leg", "foot", "<origin xyz=\"0 0 -0.4\"/>", "1 0 1"));
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
-  const drb::ArticulatedBody& body = *scene.bodies.at(0).articulated;
-  const std::size_t n = static_cast<std::size_t>(body.vertices.cols()), dofs = body.dofs();
+  const drb::BodyModel& body = scene.bodies.at(0);
+  const std::size_t n = static_cast<std::size_t>(body.vertices.cols()), dofs = body.coordinates;
   ASSERT_EQ(dofs, 8u);
   const double x[8] = { 0.3, -0.4, 1.1, 0.5, -0.2, 0.9, 0.7, 0.05 };
-  const drb::ArticulatedPose<double> pose = drb::articulatedPose(body, x);
   std::vector<std::uint32_t> every(n);
   std::vector<double> g(3 * n);
   for (std::size_t v = 0; v < n; ++v)
@@ -236,13 +235,13 @@ TEST(ArticulatedScene, AllVertexPathsAgreeWithIndexListsAndJTransposeG)
       g[3 * v + i] = std::sin(1.0 + 3.0 * v + i);
   }
   std::vector<double> p_all(3 * n), J_all(3 * dofs * n), p_list(3 * n), J_list(3 * dofs * n);
-  drb::articulatedVertexJacobians(body, pose, {}, {}, p_all.data(), J_all.data());
-  drb::articulatedVertexJacobians(body, pose, every, {}, p_list.data(), J_list.data());
+  drb_test::core_body::vertexJacobiansAt(body, false, {}, x, p_all.data(), J_all.data());
+  drb_test::core_body::vertexJacobiansAt(body, false, every, x, p_list.data(), J_list.data());
   EXPECT_EQ(p_all, p_list);
   EXPECT_EQ(J_all, J_list);
   std::vector<double> grad_all(dofs), grad_list(dofs);
-  drb::articulatedBackprop(body, pose, {}, g.data(), grad_all.data());
-  drb::articulatedBackprop(body, pose, every, g.data(), grad_list.data());
+  drb_test::core_body::backpropAt(body, {}, g.data(), x, grad_all.data());
+  drb_test::core_body::backpropAt(body, every, g.data(), x, grad_list.data());
   for (std::size_t c = 0; c < dofs; ++c)
   {
     double jtg = 0.0, scale = 0.0;
@@ -270,7 +269,7 @@ TEST(ArticulatedScene, SegmentsFollowTheDocumentWithParentsFirst)
             oneDofJoint("C_joint", "revolute", "A", "C", "<origin xyz=\"0 1 0\"/>", "0 0 1") +
             oneDofJoint("D_joint", "revolute", "B", "D", "<origin xyz=\"1 0 0\"/>", "0 0 1"));
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
-  const drb::ArticulatedBody& tree = *scene.bodies.at(0).articulated;
+  const drb::BodyModel& tree = scene.bodies.at(0);
   ASSERT_EQ(tree.segments.size(), 4u);
   EXPECT_EQ(tree.segments[1].link, "B");
   EXPECT_EQ(tree.segments[2].link, "C");
@@ -278,10 +277,9 @@ TEST(ArticulatedScene, SegmentsFollowTheDocumentWithParentsFirst)
   EXPECT_EQ(tree.segments[3].parent, 1);
   EXPECT_EQ(tree.segments[3].vertex_count, 0u);
   const double x[4] = { 0.1, 0.2, 0.3, 0.4 };
-  const drb::ArticulatedPose<double> pose = drb::articulatedPose(tree, x);
   const std::vector<double> g(3 * static_cast<std::size_t>(tree.vertices.cols()), 1.0);
   std::vector<double> gradient(4);
-  drb::articulatedBackprop(tree, pose, {}, g.data(), gradient.data());
+  drb_test::core_body::backpropAt(tree, {}, g.data(), x, gradient.data());
   EXPECT_EQ(gradient[3], 0.0) << "D moves no vertex";
   EXPECT_TRUE(Eigen::Map<const Eigen::Vector4d>(gradient.data()).allFinite());
 }
@@ -307,9 +305,10 @@ TEST(ArticulatedScene, StatesWhoseLinkPosesOverflowAreRefused)
   EXPECT_EQ(moved[0][1], 2.0);
 }
 
-// An articulated body's vertex answer is 3 (1 + d) doubles per vertex and
-// configuration: with d = 8 the free body's vertex limit alone would let
-// 113 M doubles through; the work limit refuses it before anything is allocated.
+// A vertex answer is 3 (1 + d) doubles per vertex and configuration: with
+// d = 8 the vertex limit alone would let 113 M doubles through; the answer
+// limit (RequestLimits::kMaxVertexAnswerDoubles) refuses it before anything
+// is allocated.
 TEST(ArticulatedScene, VertexRequestsOverTheWorkLimitAreRefused)
 {
   const std::string xml =

@@ -29,7 +29,7 @@
 
 #include "diff_rigid_body/exceptions.h"
 #include "diff_rigid_body/mesh_loader.h"
-#include "diff_rigid_body/rigid_body.h"
+#include "diff_rigid_body/mass_property_checks.h"
 #include "diff_rigid_body/scene_queries.h"
 #include "diff_rigid_body/state_file.h"
 #include "diff_rigid_body/urdf_scene.h"
@@ -339,8 +339,8 @@ std::vector<Row> urdfRows()
         const drb::Scene scene = drb::loadSceneFromUrdf(
             oneBody(collision(meshGeometry(kMeshDir + "/tetrahedron.obj", "-1 1 1"))), density(1000.0));
         // Mirrored, with its winding flipped: still a solid of volume 1/6 m^3.
-        EXPECT_NEAR(scene.bodies.at(0).body.mass, 1000.0 / 6.0, 1e-9);
-        EXPECT_EQ(scene.bodies.at(0).body.vertices.cols(), 4);
+        EXPECT_NEAR(scene.bodies.at(0).mass(), 1000.0 / 6.0, 1e-9);
+        EXPECT_EQ(scene.bodies.at(0).vertices.cols(), 4);
         return std::string("accepted: mirrored, winding flipped (mass from ~density stays positive)");
       } },
     { "U72", "mesh from an unknown package", Expect::Refused, "MeshLoadError", "cannot find package 'nope'",

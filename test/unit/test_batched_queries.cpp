@@ -11,9 +11,10 @@
 
 #include <gtest/gtest.h>
 
-#include "diff_rigid_body/articulated_queries.h"
 #include "diff_rigid_body/exceptions.h"
+#include "diff_rigid_body/free_body/vertex_jacobian.h"  // kStreamingStoreBytes
 #include "diff_rigid_body/scene_queries.h"
+#include "../support/body_models.h"
 #include "../support/expect_throws.h"
 #include "../support/plumbing_scenes.h"
 #include "../support/urdf_builders.h"
@@ -37,17 +38,14 @@ drb::SceneQueries cloudScene(std::size_t count)
 {
   drb::Scene scene;
   scene.fixed_frame = "world";
-  drb::SceneBody body;
-  body.body.name = "cloud";
-  body.body.mass = 1.0;
-  body.body.vertices.resize(3, static_cast<Eigen::Index>(count));
+  Eigen::Matrix3Xd vertices(3, static_cast<Eigen::Index>(count));
   std::uint64_t state = 12345;
-  for (Eigen::Index i = 0; i < body.body.vertices.size(); ++i)
+  for (Eigen::Index i = 0; i < vertices.size(); ++i)
   {
     state = state * 6364136223846793005ull + 1442695040888963407ull;
-    body.body.vertices.data()[i] = static_cast<double>(state >> 11) / 9007199254740992.0 - 0.5;
+    vertices.data()[i] = static_cast<double>(state >> 11) / 9007199254740992.0 - 0.5;
   }
-  scene.bodies.push_back(std::move(body));
+  scene.bodies.push_back(drb_test::core_body::freeObject("cloud", 1.0, Eigen::Matrix3d::Zero(), vertices));
   return drb::SceneQueries(std::move(scene));
 }
 
@@ -285,18 +283,19 @@ TEST(BatchedQueries, RefusalsNameTheConfigurationOrTheValue)
 
 // ---------------------------------------------------------------------------
 // Articulated bodies (plumbing_scenes.h): K configurations of d values; each
-// block is the bits of the direct articulated_* call and of its single request.
+// block is the bits of the direct call (vertex_jacobians.h, vertex_backprop.h)
+// and of its single request.
 namespace
 {
 /// K configurations of body `index`: a floating root's 6 from the table, then joint values.
 std::vector<double> articulatedConfigurations(const drb::SceneQueries& queries, std::size_t index, std::size_t K)
 {
-  const drb::ArticulatedBody& body = *queries.scene().bodies[index].articulated;
+  const drb::BodyModel& body = queries.body(index);
   const std::vector<double> roots = configurations(K);
   std::vector<double> q;
   for (std::size_t k = 0; k < K; ++k)
   {
-    if (body.floating_root)
+    if (body.hasFreeRoot())
       q.insert(q.end(), roots.begin() + 6 * k, roots.begin() + 6 * k + 6);
     for (std::size_t j = 0; j < body.joint_names.size(); ++j)
       q.push_back(std::sin(1.3 * static_cast<double>(k) + static_cast<double>(j)) * (k == 4 ? 1e6 : 1.0));
@@ -309,8 +308,8 @@ void expectArticulatedBlocks(const drb::SceneQueries& queries, const std::string
 {
   const drb::SceneState current = queries.initialState();
   const std::size_t index = queries.bodyIndex(name, "body");
-  const drb::ArticulatedBody& body = *queries.scene().bodies[index].articulated;
-  const std::size_t d = body.dofs(), N = selected(queries, name, vertices), w = queries.compactColumns(index);
+  const drb::BodyModel& body = queries.body(index);
+  const std::size_t d = body.coordinates, N = selected(queries, name, vertices), w = queries.compactColumns(index);
   const std::vector<double> q = articulatedConfigurations(queries, index, K);
   const std::string where = name + ", K = " + std::to_string(K) + ", N = " + std::to_string(N);
 
@@ -332,7 +331,7 @@ void expectArticulatedBlocks(const drb::SceneQueries& queries, const std::string
   // The compact columns: all but x[3..5] with a floating root, else all.
   std::vector<std::size_t> columns;
   for (std::size_t c = 0; c < d; ++c)
-    if (!body.floating_root || c < 3 || c > 5)
+    if (!body.hasFreeRoot() || c < 3 || c > 5)
       columns.push_back(c);
   ASSERT_EQ(columns.size(), w) << where;
 
@@ -341,12 +340,11 @@ void expectArticulatedBlocks(const drb::SceneQueries& queries, const std::string
     const std::string at = where + ", configuration " + std::to_string(k);
     const std::vector<double> qk = slice(q, d * k, d);
     std::vector<double> p0(3 * N), j0(3 * d * N), dL0(d);
-    const drb::ArticulatedPose<double> pose = drb::articulatedPose(body, qk.data());
-    drb::articulatedVertexJacobians(body, pose, vertices, {}, p0.data(), j0.data());
-    drb::articulatedBackprop(body, pose, vertices, g.data() + 3 * N * k, dL0.data());
-    expectSameBits(P.data() + 3 * N * k, p0.data(), 3 * N, "positions vs articulatedVertexJacobians, " + at);
-    expectSameBits(J.data() + 3 * d * N * k, j0.data(), 3 * d * N, "jacobians vs articulatedVertexJacobians, " + at);
-    expectSameBits(dL.data() + d * k, dL0.data(), d, "backprop vs articulatedBackprop, " + at);
+    drb_test::core_body::vertexJacobiansAt(body, false, vertices, qk.data(), p0.data(), j0.data());
+    drb_test::core_body::backpropAt(body, vertices, g.data() + 3 * N * k, qk.data(), dL0.data());
+    expectSameBits(P.data() + 3 * N * k, p0.data(), 3 * N, "positions vs vertexJacobians, " + at);
+    expectSameBits(J.data() + 3 * d * N * k, j0.data(), 3 * d * N, "jacobians vs vertexJacobians, " + at);
+    expectSameBits(dL.data() + d * k, dL0.data(), d, "backprop vs vertexBackprop, " + at);
     for (std::size_t n = 0; n < N; ++n)
       for (std::size_t r = 0; r < 3; ++r)
         for (std::size_t c = 0; c < w; ++c)

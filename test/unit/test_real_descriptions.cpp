@@ -65,10 +65,10 @@ TEST(RealDescriptions, ZeroMassToolFrameMergesAsMassless)
   const std::string xml = bodyWithTool(inertial("2"), inertial("0", diagonalInertia("0", "0", "0")));
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
   ASSERT_EQ(scene.bodies.size(), 1u);
-  const drb::SceneBody& body = scene.bodies[0];
-  EXPECT_EQ(body.body.mass, 2.0);
-  EXPECT_TRUE(body.body.com_offset.isZero(0.0));
-  EXPECT_NEAR((body.body.inertia_body - 0.1 * Eigen::Matrix3d::Identity()).norm(), 0.0, kLengthTolerance);
+  const drb::BodyModel& body = scene.bodies[0];
+  EXPECT_EQ(body.mass(), 2.0);
+  EXPECT_TRUE(body.rootComOffset().isZero(0.0));
+  EXPECT_NEAR((body.segments[0].inertia.inertia - 0.1 * Eigen::Matrix3d::Identity()).norm(), 0.0, kLengthTolerance);
   ASSERT_EQ(body.links.size(), 2u);
   EXPECT_EQ(body.links[1].name, "tool");
   EXPECT_EQ(body.links[1].mass_properties.mass, 0.0);
@@ -86,13 +86,13 @@ TEST(RealDescriptions, LinkWithoutInertialMergesAsMasslessAndKeepsItsVertices)
   const std::string xml =
       bodyWithTool(inertial("2") + collision(boxGeometry("1 1 1")), collision(boxGeometry("2 2 2")));
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
-  const drb::SceneBody& body = scene.bodies[0];
-  EXPECT_EQ(body.body.mass, 2.0);
-  ASSERT_EQ(body.body.vertices.cols(), 16);
+  const drb::BodyModel& body = scene.bodies[0];
+  EXPECT_EQ(body.mass(), 2.0);
+  ASSERT_EQ(body.vertices.cols(), 16);
   EXPECT_EQ(body.links[0].new_vertex_count, 8u);
   EXPECT_EQ(body.links[1].new_vertex_count, 8u);
   // tool's last corner (+1, +1, +1) in its frame is (2, 1, 1) in b's frame (the COM).
-  EXPECT_TRUE(body.body.vertices.col(15).isApprox(Eigen::Vector3d(2, 1, 1), kLengthTolerance));
+  EXPECT_TRUE(body.vertices.col(15).isApprox(Eigen::Vector3d(2, 1, 1), kLengthTolerance));
   EXPECT_TRUE(anyWarningHas(scene, "link 'tool': no <inertial> (set ~density")) << allWarnings(scene);
   DRB_EXPECT_THROWS_MESSAGE(drb::loadSceneFromUrdf(xml, strict()), drb::InvalidInertiaError,
                             "link 'tool': no <inertial>");
@@ -104,11 +104,11 @@ TEST(RealDescriptions, BodyWithoutAnyMassLoadsWithAZeroMassMatrix)
   // origin, M(q) = 0, and the warning points at ~density.
   const std::string xml = oneBody(collision(boxGeometry("1 1 1")), "<origin xyz=\"0 0 2\"/>");
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
-  const drb::SceneBody& body = scene.bodies[0];
-  EXPECT_EQ(body.body.mass, 0.0);
-  EXPECT_TRUE(body.body.com_offset.isZero(0.0));
-  EXPECT_TRUE(body.body.inertia_body.isZero(0.0));
-  EXPECT_EQ(body.initial_state[5], 2.0);
+  const drb::BodyModel& body = scene.bodies[0];
+  EXPECT_EQ(body.mass(), 0.0);
+  EXPECT_TRUE(body.rootComOffset().isZero(0.0));
+  EXPECT_TRUE(body.segments[0].inertia.inertia.isZero(0.0));
+  EXPECT_EQ(body.initial_x[5], 2.0);
   EXPECT_TRUE(anyWarningHas(scene, "body 'b': no mass in its link or merged links, so M(q) = 0"))
       << allWarnings(scene);
   const drb::SceneQueries queries(scene);
@@ -123,7 +123,7 @@ TEST(RealDescriptions, ImplausibleInertiaWarnsAndStrictRefuses)
   // (1, 1, 3) breaks I1 + I2 >= I3; (0, 1, 1) has a zero principal moment.
   const std::string triangle = oneBody(inertial("1", diagonalInertia("1", "1", "3")));
   const drb::Scene scene = drb::loadSceneFromUrdf(triangle);
-  EXPECT_EQ(scene.bodies[0].body.inertia_body(2, 2), 3.0);
+  EXPECT_EQ(scene.bodies[0].segments[0].inertia.inertia(2, 2), 3.0);
   EXPECT_TRUE(anyWarningHas(scene, "link 'b' <inertial>: principal moments break the triangle inequality"))
       << allWarnings(scene);
   DRB_EXPECT_THROWS_MESSAGE(drb::loadSceneFromUrdf(triangle, strict()), drb::InvalidInertiaError,

@@ -10,9 +10,9 @@
 
 #include <gtest/gtest.h>
 
-#include "diff_rigid_body/articulated_queries.h"
 #include "diff_rigid_body/exceptions.h"
 #include "diff_rigid_body/scene_queries.h"
+#include "../support/body_models.h"
 #include "../support/expect_throws.h"
 #include "../support/kinematics_oracles.h"
 #include "../support/plumbing_scenes.h"
@@ -53,16 +53,16 @@ TEST(SceneQueries, BatchedMassMatrixLayout)
     for (int i = 0; i < 2; ++i)
     {
       const std::size_t slot = 2 * k + i;
-      const drb::RigidBody& body = queries.body(i == 0 ? 1 : 0);
+      const drb::BodyModel& body = queries.body(i == 0 ? 1 : 0);
       // Independent reference: T^T R I_b R^T T from the elementary rotations.
       const Eigen::Matrix3d expected =
-          drb_test::refMassMatrix<double>(Eigen::Map<const drb::Vector6<double>>(q.data() + 6 * slot), body.mass,
-                                          body.inertia_body)
+          drb_test::refMassMatrix<double>(Eigen::Map<const drb::Vector6<double>>(q.data() + 6 * slot), body.mass(),
+                                          body.segments[0].inertia.inertia)
               .topLeftCorner<3, 3>();
       const Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>> M(answer.mass_matrices.data() + 36 * slot);
       EXPECT_LE((M.topLeftCorner<3, 3>() - expected).norm(), kRelativeTolerance * 10 * expected.norm());
-      EXPECT_EQ(M(3, 3), body.mass);
-      EXPECT_EQ(M(5, 5), body.mass);
+      EXPECT_EQ(M(3, 3), body.mass());
+      EXPECT_EQ(M(5, 5), body.mass());
       EXPECT_EQ(M(0, 4), 0.0);
       EXPECT_NEAR(answer.cos_theta[slot], std::cos(q[6 * slot + 1]), 1e-16);
       // dM/dpsi and dM/dt are exactly zero.
@@ -110,7 +110,7 @@ TEST(SceneQueries, SetStateIsAllOrNothingAndBitExact)
   EXPECT_EQ(next[1], current[1]);
 
   drb::NamedState nan_state{ "ball", drb::Vector6<double>::Zero() };
-  nan_state.q[4] = kNaN;
+  nan_state.x[4] = kNaN;
   DRB_EXPECT_THROWS_MESSAGE((queries.applyStates(current, { big, nan_state })), drb::InvalidArgumentError,
                             "states[1].q (body 'ball')[4]: not finite");
   DRB_EXPECT_THROWS_MESSAGE((queries.applyStates(current, { big, { "ghost", {} } })), drb::InvalidArgumentError,
@@ -283,8 +283,8 @@ TEST(SceneQueries, CompactTransportRefusesOverflow)
 // ---------------------------------------------------------------------------
 // Articulated bodies (test/support/plumbing_scenes.h: cube, ball, arm of 9
 // dofs, crane of 2): state lengths, joint_states, and the layouts of every
-// answer, each block compared bit for bit with a direct call of the
-// articulated_* functions (their numbers are tested elsewhere).
+// answer, each block compared bit for bit with a direct call of the core's
+// algorithms (crba.h, mass_matrix_derivatives.h; their numbers are tested elsewhere).
 namespace
 {
 template <typename T>
@@ -313,7 +313,7 @@ TEST(ArticulatedPlumbing, StatesHaveEachBodysDofs)
   const Eigen::VectorXd crane_x = (Eigen::VectorXd(2) << -0.0, 1e300).finished();
   const drb::SceneState next = queries.applyStates(current, { { "crane", crane_x } });
   EXPECT_TRUE(sameBits(next[3].data(), crane_x.data(), 2));
-  EXPECT_EQ(queries.getStates(next, { "crane" })[0].q, crane_x);
+  EXPECT_EQ(queries.getStates(next, { "crane" })[0].x, crane_x);
   DRB_EXPECT_THROWS_MESSAGE((queries.applyStates(current, { { "crane", crane_x }, { "arm", Eigen::VectorXd::Zero(6) } })),
                             drb::InvalidArgumentError,
                             "states[1].q (body 'arm'): expected 9 values (the body's dofs), got 6 values");
@@ -357,8 +357,10 @@ TEST(ArticulatedPlumbing, MassMatricesLayoutAndDispatch)
 {
   const drb::SceneQueries queries(drb_test::plumbing::scene());
   const drb::SceneState current = queries.initialState();
-  const drb::ArticulatedBody& arm = *queries.scene().bodies[2].articulated;
-  const drb::ArticulatedBody& crane = *queries.scene().bodies[3].articulated;
+  const drb::BodyModel& arm = queries.body(2);
+  const drb::BodyModel& crane = queries.body(3);
+  using drb_test::core_body::massMatrixAt;
+  using drb_test::core_body::massMatrixDerivativesAt;
   // K = 2 configurations of (crane, cube, arm): 2 + 6 + 9 = 17 values each.
   const std::vector<double> ac = armAndCraneQ();
   std::vector<double> q;
@@ -382,9 +384,9 @@ TEST(ArticulatedPlumbing, MassMatricesLayoutAndDispatch)
     const std::string at = "configuration " + std::to_string(k);
     // crane: M (4 values) then dM (8), cos_theta 1.
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> expected =
-        drb::articulatedMassMatrix(crane, qk);
+        massMatrixAt(crane, qk);
     EXPECT_TRUE(sameBits(M, expected.data(), 4)) << "crane M, " << at;
-    std::vector<Eigen::MatrixXd> derivatives = drb::articulatedMassMatrixDerivatives(crane, qk);
+    std::vector<Eigen::MatrixXd> derivatives = massMatrixDerivativesAt(crane, qk);
     for (int j = 0; j < 2; ++j)
     {
       expected = derivatives[j];
@@ -398,9 +400,9 @@ TEST(ArticulatedPlumbing, MassMatricesLayoutAndDispatch)
     EXPECT_TRUE(sameBits(dM + 8, cube.derivatives.data(), 216)) << "cube dM, " << at;
     EXPECT_TRUE(sameBits(&answer.cos_theta[3 * k + 1], cube.cos_theta.data(), 1)) << at;
     // arm: M (81) and dM (729), cos_theta = cos(theta).
-    expected = drb::articulatedMassMatrix(arm, qk + 8);
+    expected = massMatrixAt(arm, qk + 8);
     EXPECT_TRUE(sameBits(M + 40, expected.data(), 81)) << "arm M, " << at;
-    derivatives = drb::articulatedMassMatrixDerivatives(arm, qk + 8);
+    derivatives = massMatrixDerivativesAt(arm, qk + 8);
     for (int j = 0; j < 9; ++j)
     {
       expected = derivatives[j];
@@ -413,7 +415,7 @@ TEST(ArticulatedPlumbing, MassMatricesLayoutAndDispatch)
   EXPECT_EQ(now.dofs, (std::vector<std::uint32_t>{ 6, 6, 9, 2 }));
   EXPECT_EQ(now.mass_matrices.size(), 36u + 36u + 81u + 4u);
   const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> arm_now =
-      drb::articulatedMassMatrix(arm, current[2].data());
+      massMatrixAt(arm, current[2].data());
   EXPECT_TRUE(sameBits(now.mass_matrices.data() + 72, arm_now.data(), 81));
 
   DRB_EXPECT_THROWS_MESSAGE((queries.massMatrices(current, { "crane", "cube", "arm" }, std::vector<double>(33, 0.0), false)),

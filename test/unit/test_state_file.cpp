@@ -239,8 +239,8 @@ TEST(StateFile, ArticulatedBodiesRoundTripAndAreFingerprinted)
 {
   const drb::Scene scene = drb_test::plumbing::scene();
   drb::SceneState state;
-  for (const drb::SceneBody& body : scene.bodies)
-    state.push_back(body.initial_state);
+  for (const drb::BodyModel& body : scene.bodies)
+    state.push_back(body.initial_x);
   state[2][8] = -0.0;
   state[3][1] = 5e-324;
   const std::string text = drb::formatStateFile(scene, state);
@@ -252,20 +252,21 @@ TEST(StateFile, ArticulatedBodiesRoundTripAndAreFingerprinted)
   EXPECT_TRUE(drb_test::bitwiseEqual(drb::parseStateFile(text, scene), state)) << text;
 
   // Each change below moves the robot's vertices for the same x: another fingerprint.
-  const auto changed = [](const std::function<void(drb::ArticulatedBody&)>& change) {
-    std::shared_ptr<drb::ArticulatedBody> arm = drb_test::plumbing::arm();
-    change(*arm);
+  const auto changed = [](const std::function<void(drb::BodyModel&)>& change) {
+    drb::BodyModel arm = drb_test::plumbing::arm();
+    change(arm);
+    drb_test::core_body::refreshDerivedFields(arm);
     return drb_test::plumbing::scene(arm);
   };
   const std::vector<std::pair<std::string, drb::Scene>> others = {
-    { "origin", changed([](drb::ArticulatedBody& b) { b.segments[2].origin.translation()[0] += 1e-12; }) },
-    { "axis", changed([](drb::ArticulatedBody& b) { b.segments[1].axis = -b.segments[1].axis; }) },
-    { "motion", changed([](drb::ArticulatedBody& b) { b.segments[3].motion = drb::JointMotion::Revolute; }) },
-    { "mimic", changed([](drb::ArticulatedBody& b) { b.segments[4].multiplier = 0.5; }) },
-    { "mass", changed([](drb::ArticulatedBody& b) { b.segments[1].mass_properties.mass *= 2; }) },
-    { "vertex", changed([](drb::ArticulatedBody& b) { b.vertices(1, 13) += 1e-9; }) },
-    { "joint", changed([](drb::ArticulatedBody& b) { b.segments[1].joint = "hip"; }) },
-    { "tree", changed([](drb::ArticulatedBody& b) { b.segments[4].parent = 1; }) },
+    { "origin", changed([](drb::BodyModel& b) { b.segments[2].placement_translation[0] += 1e-12; }) },
+    { "axis", changed([](drb::BodyModel& b) { b.segments[1].axis = -b.segments[1].axis; }) },
+    { "motion", changed([](drb::BodyModel& b) { b.segments[3].joint_type = drb::JointType::Revolute; }) },
+    { "mimic", changed([](drb::BodyModel& b) { b.dofs[b.segments[4].first_dof].multiplier = 0.5; }) },
+    { "mass", changed([](drb::BodyModel& b) { b.segments[1].inertia.mass *= 2; }) },
+    { "vertex", changed([](drb::BodyModel& b) { b.vertices(1, 13) += 1e-9; }) },
+    { "joint", changed([](drb::BodyModel& b) { b.segments[1].joint = "hip"; }) },
+    { "tree", changed([](drb::BodyModel& b) { b.segments[4].parent = 1; }) },
   };
   for (const auto& other : others)
   {

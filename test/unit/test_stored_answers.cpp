@@ -309,7 +309,7 @@ void checkScene(const SceneSpec& spec, AnswerBook& book)
   for (std::size_t i = 0; i < bodies.size(); ++i)
   {
     const BodyInputs& in = bodies[i];
-    const std::vector<double> initial(states[i].q.data(), states[i].q.data() + states[i].q.size());
+    const std::vector<double> initial(states[i].x.data(), states[i].x.data() + states[i].x.size());
     book.numbers(in.name, "initial_state", initial, matches[i]);
     book.numbers(in.name, "vertex_count", std::vector<double>{ double(in.vertex_count) }, Match::Exact);
     // Configurations 1..K-1 are the test's own numbers (configuration 0 is

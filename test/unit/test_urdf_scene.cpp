@@ -34,12 +34,12 @@ TEST(UrdfScene, ComOffsetAndRotatedInertialFrame)
       floatingJoint("body", "<origin xyz=\"1 2 3\"/>"));
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
   ASSERT_EQ(scene.bodies.size(), 1u);
-  const drb::RigidBody& body = scene.bodies[0].body;
+  const drb::BodyModel& body = scene.bodies[0];
   EXPECT_EQ(scene.fixed_frame, "world");
   EXPECT_EQ(body.name, "body");
-  EXPECT_DOUBLE_EQ(body.mass, 2.0);
-  EXPECT_TRUE(body.com_offset.isApprox(Eigen::Vector3d(0.1, 0.2, 0.3), kLengthTolerance));
-  EXPECT_NEAR((body.inertia_body - Eigen::Vector3d(2, 1, 3).asDiagonal().toDenseMatrix()).norm(), 0.0,
+  EXPECT_DOUBLE_EQ(body.mass(), 2.0);
+  EXPECT_TRUE(body.rootComOffset().isApprox(Eigen::Vector3d(0.1, 0.2, 0.3), kLengthTolerance));
+  EXPECT_NEAR((body.segments[0].inertia.inertia - Eigen::Vector3d(2, 1, 3).asDiagonal().toDenseMatrix()).norm(), 0.0,
               kInertiaTolerance);
   // The box is centred on the COM, so its corners are (+-0.1, +-0.2, +-0.3) in the body frame.
   ASSERT_EQ(body.vertices.cols(), 8);
@@ -47,7 +47,7 @@ TEST(UrdfScene, ComOffsetAndRotatedInertialFrame)
   EXPECT_TRUE(body.vertices.col(7).isApprox(Eigen::Vector3d(0.1, 0.2, 0.3), kLengthTolerance));
   // q = (0, 0, 0, joint origin + COM offset).
   const drb::Vector6<double> expected = (drb::Vector6<double>() << 0, 0, 0, 1.1, 2.2, 3.3).finished();
-  EXPECT_NEAR((scene.bodies[0].initial_state - expected).norm(), 0.0, kLengthTolerance);
+  EXPECT_NEAR((scene.bodies[0].initial_x - expected).norm(), 0.0, kLengthTolerance);
 }
 
 TEST(UrdfScene, MergesFixedLinksTransitivelyWithParallelAxisInertia)
@@ -61,21 +61,21 @@ TEST(UrdfScene, MergesFixedLinksTransitivelyWithParallelAxisInertia)
                                 joint("fixed", "arm", "tip", "<origin xyz=\"0 1 0\" rpy=\"0.3 0 0\"/>"));
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
   ASSERT_EQ(scene.bodies.size(), 1u);
-  const drb::SceneBody& body = scene.bodies[0];
-  EXPECT_DOUBLE_EQ(body.body.mass, 2.0);
-  EXPECT_TRUE(body.body.com_offset.isApprox(Eigen::Vector3d(0.5, 0, 0), kLengthTolerance));
-  EXPECT_NEAR((body.body.inertia_body - Eigen::Vector3d(0.2, 0.7, 0.7).asDiagonal().toDenseMatrix()).norm(), 0.0,
-              kInertiaTolerance);
+  const drb::BodyModel& body = scene.bodies[0];
+  EXPECT_DOUBLE_EQ(body.mass(), 2.0);
+  EXPECT_TRUE(body.rootComOffset().isApprox(Eigen::Vector3d(0.5, 0, 0), kLengthTolerance));
+  const Eigen::Matrix3d& inertia = body.segments[0].inertia.inertia;
+  EXPECT_NEAR((inertia - Eigen::Vector3d(0.2, 0.7, 0.7).asDiagonal().toDenseMatrix()).norm(), 0.0, kInertiaTolerance);
   ASSERT_EQ(body.links.size(), 3u);
   EXPECT_EQ(body.links[0].name, "base");
   EXPECT_EQ(body.links[1].name, "arm");
   EXPECT_EQ(body.links[2].name, "tip");
-  EXPECT_TRUE(body.links[2].pose_in_body_link.translation().isApprox(Eigen::Vector3d(1, 1, 0), kLengthTolerance));
+  EXPECT_TRUE(body.links[2].pose_in_segment_link.translation().isApprox(Eigen::Vector3d(1, 1, 0), kLengthTolerance));
   // Yaw 0.5 from the joint; the COM sits 0.5 m along the body's rotated x axis.
-  EXPECT_NEAR(body.initial_state[drb::PSI], 0.5, kAngleTolerance);
-  EXPECT_NEAR(body.initial_state[drb::TX], 0.5 * std::cos(0.5), kLengthTolerance);
-  EXPECT_NEAR(body.initial_state[drb::TY], 0.5 * std::sin(0.5), kLengthTolerance);
-  EXPECT_NEAR(body.initial_state[drb::TZ], 1.0, kLengthTolerance);
+  EXPECT_NEAR(body.initial_x[drb::PSI], 0.5, kAngleTolerance);
+  EXPECT_NEAR(body.initial_x[drb::TX], 0.5 * std::cos(0.5), kLengthTolerance);
+  EXPECT_NEAR(body.initial_x[drb::TY], 0.5 * std::sin(0.5), kLengthTolerance);
+  EXPECT_NEAR(body.initial_x[drb::TZ], 1.0, kLengthTolerance);
   EXPECT_TRUE(scene.unmodelled_joints.empty());
 }
 
@@ -95,10 +95,10 @@ TEST(UrdfScene, StaticLinksAndUnmodelledJointsWhenJointsAreFree)
   EXPECT_EQ(scene.static_links[0].name, "table");
   EXPECT_TRUE(scene.static_links[0].pose_in_fixed_frame.translation().isApprox(Eigen::Vector3d(0, 0, 0.5)));
   ASSERT_EQ(scene.bodies.size(), 2u);
-  EXPECT_EQ(scene.bodies[0].body.name, "box");
-  EXPECT_EQ(scene.bodies[1].body.name, "flap");
-  EXPECT_NEAR(scene.bodies[0].initial_state[drb::TZ], 1.5, kLengthTolerance);
-  EXPECT_NEAR(scene.bodies[1].initial_state[drb::TZ], 1.75, kLengthTolerance);
+  EXPECT_EQ(scene.bodies[0].name, "box");
+  EXPECT_EQ(scene.bodies[1].name, "flap");
+  EXPECT_NEAR(scene.bodies[0].initial_x[drb::TZ], 1.5, kLengthTolerance);
+  EXPECT_NEAR(scene.bodies[1].initial_x[drb::TZ], 1.75, kLengthTolerance);
   ASSERT_EQ(scene.unmodelled_joints.size(), 1u);
   EXPECT_NE(scene.unmodelled_joints[0].find("hinge"), std::string::npos);
 
@@ -106,7 +106,7 @@ TEST(UrdfScene, StaticLinksAndUnmodelledJointsWhenJointsAreFree)
   drb::SceneOptions in_table = free_joints;
   in_table.fixed_frame = "table";
   const drb::Scene relative = drb::loadSceneFromUrdf(xml, in_table);
-  EXPECT_NEAR(relative.bodies[0].initial_state[drb::TZ], 1.0, kLengthTolerance);
+  EXPECT_NEAR(relative.bodies[0].initial_x[drb::TZ], 1.0, kLengthTolerance);
   ASSERT_EQ(relative.static_links.size(), 1u);
   EXPECT_EQ(relative.static_links[0].name, "world");
   EXPECT_NEAR(relative.static_links[0].pose_in_fixed_frame.translation().z(), -0.5, kLengthTolerance);
@@ -116,7 +116,7 @@ TEST(UrdfScene, StaticLinksAndUnmodelledJointsWhenJointsAreFree)
   only_flap.bodies = { "flap" };
   const drb::Scene subset = drb::loadSceneFromUrdf(xml, only_flap);
   ASSERT_EQ(subset.bodies.size(), 1u);
-  EXPECT_EQ(subset.bodies[0].body.name, "flap");
+  EXPECT_EQ(subset.bodies[0].name, "flap");
 }
 
 TEST(UrdfScene, MeshScaleAndOriginFromAFile)
@@ -129,7 +129,7 @@ TEST(UrdfScene, MeshScaleAndOriginFromAFile)
   const std::string mesh = meshGeometry("file://" + kTestMeshDir + "/tetrahedron.obj", "2 3 4");
   const std::string xml = robot(link("tet", inertial() + collision(mesh, origin)) + floatingJoint("tet"));
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
-  const Eigen::Matrix3Xd& v = scene.bodies[0].body.vertices;
+  const Eigen::Matrix3Xd& v = scene.bodies[0].vertices;
   ASSERT_EQ(v.cols(), 4);
   EXPECT_TRUE(v.col(0).isApprox(Eigen::Vector3d(0.5, 0, 0), kLengthTolerance));
   EXPECT_TRUE(v.col(1).isApprox(Eigen::Vector3d(-2.5, 0, 0), kLengthTolerance));
@@ -149,10 +149,10 @@ TEST(UrdfScene, PackageUrisAndVisualGeometry)
     return package == "test_pkg" ? std::string(DRB_TEST_DATA_DIR) : std::string();
   };
   // Collision (the default) gives the documented 114-vertex sphere.
-  EXPECT_EQ(drb::loadSceneFromUrdf(xml, options).bodies[0].body.vertices.cols(), 114);
+  EXPECT_EQ(drb::loadSceneFromUrdf(xml, options).bodies[0].vertices.cols(), 114);
   // Visual gives the STL box; its 36 triangle corners join into 8 vertices.
   options.geometry = drb::GeometrySource::Visual;
-  EXPECT_EQ(drb::loadSceneFromUrdf(xml, options).bodies[0].body.vertices.cols(), 8);
+  EXPECT_EQ(drb::loadSceneFromUrdf(xml, options).bodies[0].vertices.cols(), 8);
 
   drb::SceneOptions no_resolver;
   no_resolver.geometry = drb::GeometrySource::Visual;
@@ -170,10 +170,9 @@ TEST(UrdfScene, InertiaFromDensity)
   drb::SceneOptions options;
   options.density = 1000.0;
   const drb::Scene scene = drb::loadSceneFromUrdf(xml, options);
-  EXPECT_NEAR(scene.bodies[0].body.mass, 6000.0, 1e-9);
-  EXPECT_NEAR((scene.bodies[0].body.inertia_body - Eigen::Vector3d(6500, 5000, 2500).asDiagonal().toDenseMatrix())
-                  .norm(),
-              0.0, 1e-8);
+  EXPECT_NEAR(scene.bodies[0].mass(), 6000.0, 1e-9);
+  const Eigen::Matrix3d& inertia = scene.bodies[0].segments[0].inertia.inertia;
+  EXPECT_NEAR((inertia - Eigen::Vector3d(6500, 5000, 2500).asDiagonal().toDenseMatrix()).norm(), 0.0, 1e-8);
 }
 
 TEST(UrdfScene, RejectsUnusableDescriptions)

@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "diff_rigid_body/body_pose.h"
+#include "diff_rigid_body/free_body/pose.h"
 #include "diff_rigid_body/detail/cpu_features.h"
 #include "diff_rigid_body/types.h"
 

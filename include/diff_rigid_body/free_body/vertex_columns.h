@@ -21,7 +21,7 @@
 
 #include "diff_rigid_body/detail/backprop_sums.h"
 #include "diff_rigid_body/types.h"
-#include "diff_rigid_body/vertex_jacobian.h"
+#include "diff_rigid_body/free_body/vertex_jacobian.h"
 
 namespace diff_rigid_body
 {

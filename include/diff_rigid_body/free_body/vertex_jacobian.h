@@ -20,7 +20,7 @@
 #include <type_traits>
 #include <vector>
 
-#include "diff_rigid_body/body_pose.h"
+#include "diff_rigid_body/free_body/pose.h"
 #include "diff_rigid_body/detail/backprop_sums.h"
 #include "diff_rigid_body/detail/vertex_kernels_sse2.h"
 #include "diff_rigid_body/types.h"

@@ -1,0 +1,97 @@
+// M = L^T D L along the body's tree (Featherstone 2008, section 6.3, "LTDL"),
+// for forward dynamics (forward_dynamics.h).
+//
+// In dof order M has the tree's sparsity: M(i, j) != 0 only when one of the
+// dofs i, j is an ancestor of the other. Eliminating from the leaves up,
+// row k only ever updates the rows of its ancestors, so no fill-in occurs:
+//   for k = last..0, for i = each ancestor of k:
+//     a = M(k, i) / M(k, k);  M(i, j) -= a M(k, j) for j = i and its ancestors;  L(k, i) = a
+// and D = diag of what is left. Work O(dofs x depth^2); a chain (depth = d)
+// is the dense LDL^T, which serves bodies with mimic joints (several dofs per
+// coordinate). BodyModel::factor_coordinate and factor_parent give the order.
+//
+// M is positive semidefinite; a pivot D_k <= d eps max_i M_ii (rounding of
+// a zero) means M is singular: at gimbal lock of a free root, or a coordinate
+// that moves no mass. The factorization then reports the row's coordinate.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <limits>
+
+#include "diff_rigid_body/body_workspace.h"
+
+namespace diff_rigid_body
+{
+namespace detail
+{
+/// |value| in double for the singularity test: the real part of a complex
+/// step (its imaginary part carries derivatives, not size).
+template <typename Scalar>
+double pivotMagnitude(const Scalar& value)
+{
+  using std::abs;
+  return static_cast<double>(abs(value));
+}
+template <typename Real>
+double pivotMagnitude(const std::complex<Real>& value)
+{
+  return std::abs(static_cast<double>(value.real()));
+}
+}  // namespace detail
+
+/// Factors ws.M into ws.factor (rows and columns in factorization order).
+/// Returns -1, or the coordinate of the first pivot found singular.
+template <typename Scalar>
+int factorMassMatrix(const BodyModel& model, BodyWorkspace<Scalar>& ws)
+{
+  const int d = static_cast<int>(model.coordinates);
+  auto& H = ws.factor;
+  for (int r = 0; r < d; ++r)
+    for (int c = 0; c < d; ++c)
+      H(r, c) = ws.M(model.factor_coordinate[static_cast<std::size_t>(r)], model.factor_coordinate[static_cast<std::size_t>(c)]);
+  double largest = 0.0;
+  for (int k = 0; k < d; ++k)
+    largest = std::max(largest, detail::pivotMagnitude(H(k, k)));
+  const double tolerance = d * std::numeric_limits<double>::epsilon() * largest;
+  int singular = -1;
+  for (int k = d - 1; k >= 0; --k)
+  {
+    if (!(detail::pivotMagnitude(H(k, k)) > tolerance) && singular < 0)
+      singular = model.factor_coordinate[static_cast<std::size_t>(k)];
+    for (int i = model.factor_parent[static_cast<std::size_t>(k)]; i >= 0; i = model.factor_parent[static_cast<std::size_t>(i)])
+    {
+      const Scalar a = H(k, i) / H(k, k);
+      for (int j = i; j >= 0; j = model.factor_parent[static_cast<std::size_t>(j)])
+        H(i, j) -= a * H(k, j);
+      H(k, i) = a;
+    }
+  }
+  return singular;
+}
+
+/// Solves M y = b for b given in x order (d values at `b`), in place, with
+/// the factorization in ws. ws.solution is used as scratch.
+template <typename Scalar>
+void solveMassMatrix(const BodyModel& model, BodyWorkspace<Scalar>& ws, Scalar* b)
+{
+  const int d = static_cast<int>(model.coordinates);
+  const auto& H = ws.factor;
+  auto& y = ws.solution;
+  const auto parent = [&](int k) { return model.factor_parent[static_cast<std::size_t>(k)]; };
+  for (int k = 0; k < d; ++k)
+    y[k] = b[model.factor_coordinate[static_cast<std::size_t>(k)]];
+  for (int k = d - 1; k >= 0; --k)  // L^T z = b
+    for (int j = parent(k); j >= 0; j = parent(j))
+      y[j] -= H(k, j) * y[k];
+  for (int k = 0; k < d; ++k)  // D w = z
+    y[k] /= H(k, k);
+  for (int k = 0; k < d; ++k)  // L y = w
+    for (int j = parent(k); j >= 0; j = parent(j))
+      y[k] -= H(k, j) * y[j];
+  for (int k = 0; k < d; ++k)
+    b[model.factor_coordinate[static_cast<std::size_t>(k)]] = y[k];
+}
+
+}  // namespace diff_rigid_body

@@ -1,0 +1,206 @@
+// SceneQueries::inverseDynamics and forwardDynamics: the requests' checks
+// and layout (as get_mass_matrix's), and the algorithms per body and
+// configuration (rnea.h, rnea_derivatives.h, forward_dynamics.h).
+#include <cmath>
+#include <initializer_list>
+#include <sstream>
+
+#include "diff_rigid_body/forward_dynamics.h"
+#include "diff_rigid_body/scene_queries.h"
+#include "request_checks.h"
+#include "request_layout.h"
+
+namespace diff_rigid_body
+{
+using detail::reject;
+using detail::sizeMismatch;
+
+namespace
+{
+/// The K of a dynamics request: from q (K D values; empty = 1), with each
+/// other array of q's length (K D) or empty, every value finite.
+std::size_t dynamicsConfigurations(const detail::RequestLayout& layout, std::size_t bodies,
+                                   const std::vector<double>& q,
+                                   std::initializer_list<std::pair<const char*, const std::vector<double>*>> others)
+{
+  if (!q.empty() && (bodies == 0 || q.size() % layout.D != 0))
+    reject(sizeMismatch("q",
+                        "a multiple of " + std::to_string(layout.D) + " values (the sum of the " +
+                            std::to_string(bodies) + " bodies' dofs), or empty for the current state",
+                        q.size()));
+  const std::size_t configurations = q.empty() ? 1 : q.size() / layout.D;
+  requireFinite(q.data(), q.size(), "q");
+  for (const auto& [field, values] : others)
+  {
+    if (!values->empty() && values->size() != configurations * layout.D)
+      reject(sizeMismatch(field,
+                          std::to_string(configurations * layout.D) + " values (q's " + std::to_string(configurations) +
+                              " configuration(s) x " + std::to_string(layout.D) + "), or empty for zeros",
+                          values->size()));
+    requireFinite(values->data(), values->size(), field);
+  }
+  return configurations;
+}
+
+/// Refuses an answer of more doubles than the budget of get_mass_matrix
+/// (with matrices: its budget with derivatives).
+void checkDynamicsBudget(std::size_t configurations, std::size_t per_configuration, bool matrices)
+{
+  const std::size_t budget =
+      matrices ? RequestLimits::kMaxMassMatrixDoublesWithDerivatives : RequestLimits::kMaxMassMatrixDoubles;
+  if (per_configuration == 0 || configurations <= budget / per_configuration)
+    return;
+  std::ostringstream why;
+  why << "q: expected at most " << budget << " answer values, got " << configurations << " configuration(s) x "
+      << per_configuration << " values";
+  reject(why.str());
+}
+
+/// `matrix` (d x d, column-major) row-major at `out`, times `scale`.
+void writeRowMajor(const Eigen::MatrixXd& matrix, double scale, double* out)
+{
+  const Eigen::Index d = matrix.rows();
+  for (Eigen::Index r = 0; r < d; ++r)
+    for (Eigen::Index c = 0; c < d; ++c)
+      out[r * d + c] = scale * matrix(r, c);
+}
+
+/// Why M is singular at x in `coordinate` (factorMassMatrix's report).
+std::string singularReason(const BodyModel& body, const double* x, int coordinate)
+{
+  std::ostringstream why;
+  why.precision(17);
+  if (body.hasFreeRoot() && coordinate < 3)
+    why << "its rotation coordinates (phi, theta, psi) are singular: pitch theta = " << x[THETA]
+        << " rad, cos(theta) = " << std::cos(x[THETA])
+        << " (gimbal lock at cos(theta) = 0, or a principal moment of inertia 0)";
+  else if (body.hasFreeRoot() && coordinate < 6)
+    why << "its free root moves no mass (coordinate x[" << coordinate << "])";
+  else
+    why << "coordinate x[" << coordinate << "] (joint '"
+        << body.joint_names[static_cast<std::size_t>(coordinate) - body.rootCoordinates()] << "') moves no mass";
+  return why.str();
+}
+
+template <typename Answer>
+void setBodies(const SceneQueries& queries, const std::vector<std::size_t>& indices, Answer& answer)
+{
+  answer.bodies.resize(indices.size());
+  answer.dofs.resize(indices.size());
+  for (std::size_t i = 0; i < indices.size(); ++i)
+  {
+    answer.bodies[i] = queries.body(indices[i]).name;
+    answer.dofs[i] = static_cast<std::uint32_t>(queries.dofs(indices[i]));
+  }
+}
+
+const double* slice(const std::vector<double>& values, std::size_t offset)
+{
+  return values.empty() ? nullptr : values.data() + offset;
+}
+}  // namespace
+
+void SceneQueries::inverseDynamics(const SceneState& current, const std::vector<std::string>& names,
+                                   const std::vector<double>& q, const std::vector<double>& qdot,
+                                   const std::vector<double>& qddot, bool coriolis, bool derivatives,
+                                   InverseDynamicsAnswer& answer) const
+{
+  thread_local std::vector<std::size_t> indices;
+  bodyIndices(names, "bodies", indices);
+  const detail::RequestLayout& layout = detail::requestLayout(*this, indices);
+  const std::size_t n = indices.size();
+  const std::size_t K = dynamicsConfigurations(layout, n, q, { { "qdot", &qdot }, { "qddot", &qddot } });
+  const std::size_t matrices = (coriolis ? 1 : 0) + (derivatives ? 2 : 0);
+  checkDynamicsBudget(K, 3 * layout.D + matrices * layout.per_m + n, matrices > 0);
+  setBodies(*this, indices, answer);
+  answer.tau.resize(K * layout.D);
+  answer.velocity_terms.resize(K * layout.D);
+  answer.gravity_terms.resize(K * layout.D);
+  answer.coriolis_matrices.resize(coriolis ? K * layout.per_m : 0);
+  answer.dtau_dq.resize(derivatives ? K * layout.per_m : 0);
+  answer.dtau_dqdot.resize(derivatives ? K * layout.per_m : 0);
+  answer.cos_theta.resize(K * n);
+  const Vector3<double> no_gravity = Vector3<double>::Zero();
+  for (std::size_t k = 0; k < K; ++k)
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      const BodyModel& body = scene_.bodies[indices[i]];
+      BodyWorkspace<double>& ws = workspace(indices[i]);
+      const std::size_t v = k * layout.D + layout.x_offset[i], m = k * layout.per_m + layout.m_offset[i];
+      const double* x = q.empty() ? current[indices[i]].data() : q.data() + v;
+      const double *xd = slice(qdot, v), *xdd = slice(qddot, v);
+      diff_rigid_body::inverseDynamics(body, ws, x, xd, static_cast<const double*>(nullptr), no_gravity,
+                                       answer.velocity_terms.data() + v);
+      inverseDynamicsFromKinematics(body, ws, static_cast<const double*>(nullptr), static_cast<const double*>(nullptr),
+                                    gravity_, answer.gravity_terms.data() + v);
+      inverseDynamicsFromKinematics(body, ws, xd, xdd, gravity_, answer.tau.data() + v);
+      if (matrices > 0)
+      {
+        inverseDynamicsDerivatives(body, ws, x, xd, xdd, gravity_, ws.derivative_x, ws.derivative_xd);
+        if (coriolis)
+          writeRowMajor(ws.derivative_xd, 0.5, answer.coriolis_matrices.data() + m);
+        if (derivatives)
+        {
+          writeRowMajor(ws.derivative_x, 1.0, answer.dtau_dq.data() + m);
+          writeRowMajor(ws.derivative_xd, 1.0, answer.dtau_dqdot.data() + m);
+        }
+      }
+      answer.cos_theta[k * n + i] = body.hasFreeRoot() ? std::cos(x[THETA]) : 1.0;
+    }
+  for (const auto& [field, values] :
+       { std::make_pair("result tau", &answer.tau), std::make_pair("result velocity_terms", &answer.velocity_terms),
+         std::make_pair("result gravity_terms", &answer.gravity_terms),
+         std::make_pair("result coriolis_matrices", &answer.coriolis_matrices),
+         std::make_pair("result dtau_dq", &answer.dtau_dq), std::make_pair("result dtau_dqdot", &answer.dtau_dqdot) })
+    requireFinite(values->data(), values->size(), field);
+}
+
+void SceneQueries::forwardDynamics(const SceneState& current, const std::vector<std::string>& names,
+                                   const std::vector<double>& q, const std::vector<double>& qdot,
+                                   const std::vector<double>& tau, bool derivatives,
+                                   ForwardDynamicsAnswer& answer) const
+{
+  thread_local std::vector<std::size_t> indices;
+  bodyIndices(names, "bodies", indices);
+  const detail::RequestLayout& layout = detail::requestLayout(*this, indices);
+  const std::size_t n = indices.size();
+  const std::size_t K = dynamicsConfigurations(layout, n, q, { { "qdot", &qdot }, { "tau", &tau } });
+  checkDynamicsBudget(K, layout.D + (derivatives ? 3 * layout.per_m : 0) + n, derivatives);
+  setBodies(*this, indices, answer);
+  answer.qddot.resize(K * layout.D);
+  answer.dqddot_dq.resize(derivatives ? K * layout.per_m : 0);
+  answer.dqddot_dqdot.resize(derivatives ? K * layout.per_m : 0);
+  answer.dqddot_dtau.resize(derivatives ? K * layout.per_m : 0);
+  answer.cos_theta.resize(K * n);
+  for (std::size_t k = 0; k < K; ++k)
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      const BodyModel& body = scene_.bodies[indices[i]];
+      BodyWorkspace<double>& ws = workspace(indices[i]);
+      const std::size_t v = k * layout.D + layout.x_offset[i], m = k * layout.per_m + layout.m_offset[i];
+      const double* x = q.empty() ? current[indices[i]].data() : q.data() + v;
+      const double *xd = slice(qdot, v), *generalized_force = slice(tau, v);
+      double* xdd = answer.qddot.data() + v;
+      const int singular =
+          derivatives ? forwardDynamicsDerivatives(body, ws, x, xd, generalized_force, gravity_, xdd, ws.derivative_x,
+                                                   ws.derivative_xd, ws.inverse_mass) :
+                        diff_rigid_body::forwardDynamics(body, ws, x, xd, generalized_force, gravity_, xdd);
+      if (singular >= 0)
+        reject((K > 1 ? "q (configuration " + std::to_string(k) + ")" : std::string("q")) + ": body '" + body.name +
+               "': M(x) is singular, so forward dynamics is undefined there: " + singularReason(body, x, singular));
+      if (derivatives)
+      {
+        writeRowMajor(ws.derivative_x, 1.0, answer.dqddot_dq.data() + m);
+        writeRowMajor(ws.derivative_xd, 1.0, answer.dqddot_dqdot.data() + m);
+        writeRowMajor(ws.inverse_mass, 1.0, answer.dqddot_dtau.data() + m);
+      }
+      answer.cos_theta[k * n + i] = body.hasFreeRoot() ? std::cos(x[THETA]) : 1.0;
+    }
+  for (const auto& [field, values] :
+       { std::make_pair("result qddot", &answer.qddot), std::make_pair("result dqddot_dq", &answer.dqddot_dq),
+         std::make_pair("result dqddot_dqdot", &answer.dqddot_dqdot),
+         std::make_pair("result dqddot_dtau", &answer.dqddot_dtau) })
+    requireFinite(values->data(), values->size(), field);
+}
+
+}  // namespace diff_rigid_body
