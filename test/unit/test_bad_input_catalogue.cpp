@@ -1,5 +1,6 @@
 // The bad-input catalogue of docs/robustness.md, one gtest per row: URDF
-// descriptions (U), mesh files (M), service requests (R) and state files (S).
+// descriptions (U), mesh files (M), service requests (R), state files (S)
+// and the dynamics services (D, test_dynamics_catalogue.cpp).
 // (Node parameters and the ROS transport are rostests: P and T rows.)
 //
 // Each row runs one input through the ROS-free core and checks
@@ -33,6 +34,7 @@
 #include "diff_rigid_body/scene_queries.h"
 #include "diff_rigid_body/state_file.h"
 #include "diff_rigid_body/urdf_scene.h"
+#include "../support/catalogue_row.h"
 #include "../support/plumbing_scenes.h"
 #include "../support/state_files.h"
 #include "../support/urdf_builders.h"
@@ -57,29 +59,8 @@ const std::string kDoc = kTestDir + "/../docs/robustness.md";
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-enum class Expect
-{
-  Refused,
-  Accepted
-};
-
-struct Row
-{
-  std::string id;     ///< "U01": the line of the doc's table
-  std::string input;  ///< what is tried (first column of the doc's table)
-  Expect expect = Expect::Refused;
-  std::string type;      ///< error class when refused, e.g. "SceneDescriptionError"
-  std::string fragment;  ///< must be in the message (when refused)
-  /// Runs the input; throws when refused. When accepted it returns a short
-  /// description of the outcome (checked with EXPECT_* inside).
-  std::function<std::string()> run;
-};
-
-// gtest prints a row by its id.
-void PrintTo(const Row& row, std::ostream* out)
-{
-  *out << row.id;
-}
+using drb_test::catalogue::Expect;
+using drb_test::catalogue::Row;
 
 std::string errorType(const drb::Error& e)
 {
@@ -964,4 +945,5 @@ INSTANTIATE_TEST_SUITE_P(Urdf, Catalogue, ::testing::ValuesIn(urdfRows()), rowNa
 INSTANTIATE_TEST_SUITE_P(Mesh, Catalogue, ::testing::ValuesIn(meshRows()), rowName);
 INSTANTIATE_TEST_SUITE_P(Request, Catalogue, ::testing::ValuesIn(requestRows()), rowName);
 INSTANTIATE_TEST_SUITE_P(StateFile, Catalogue, ::testing::ValuesIn(stateFileRows()), rowName);
+INSTANTIATE_TEST_SUITE_P(Dynamics, Catalogue, ::testing::ValuesIn(drb_test::catalogue::dynamicsRows()), rowName);
 }  // namespace
