@@ -11,6 +11,7 @@
 // --benchmark_format=json; the errors come from drb_bench_accuracy.
 #include <benchmark/benchmark.h>
 
+#include <cstdio>
 #include <cstring>
 #include <functional>
 #include <map>
@@ -19,6 +20,7 @@
 
 #include "bench_common.h"
 #include "diff_rigid_body/scene_queries.h"
+#include "diff_rigid_body/urdf_scene.h"
 #include "methods.h"
 #include "vertex_benchmarks.h"
 
@@ -157,6 +159,27 @@ void registerMassMatrix()
 #endif
   }
 }
+/// A URDF of `bodies` free bodies "body<i>" on floating joints, each with
+/// the benchmark body's mass [kg] and inertia about its COM [kg m^2] (link
+/// frame at the COM), no geometry.
+std::string freeBodiesUrdf(std::size_t bodies)
+{
+  const Matrix3d& I = body().inertia;
+  char inertial[400];
+  std::snprintf(inertial, sizeof(inertial),
+                "<inertial><origin xyz=\"0 0 0\"/><mass value=\"%.17g\"/><inertia ixx=\"%.17g\" ixy=\"%.17g\" "
+                "ixz=\"%.17g\" iyy=\"%.17g\" iyz=\"%.17g\" izz=\"%.17g\"/></inertial>",
+                body().mass, I(0, 0), I(0, 1), I(0, 2), I(1, 1), I(1, 2), I(2, 2));
+  std::string urdf = "<robot name=\"bench\"><link name=\"world\"/>";
+  for (std::size_t i = 0; i < bodies; ++i)
+  {
+    const std::string name = "body" + std::to_string(i);
+    urdf += "<link name=\"" + name + "\">" + inertial + "</link><joint name=\"" + name +
+            "_joint\" type=\"floating\"><parent link=\"world\"/><child link=\"" + name + "\"/></joint>";
+  }
+  return urdf + "</robot>";
+}
+
 /// SceneQueries::massMatrices for K configurations of `bodies` bodies (the
 /// benchmark body, and copies of it under other names): what the node runs
 /// for ~get_mass_matrix, from the request's q to the answer's vectors.
@@ -164,17 +187,10 @@ void registerNodeMassMatrix(std::size_t bodies, std::size_t K)
 {
   const std::string name = "mass_matrix_node/" + std::to_string(bodies) + "_bod" + (bodies == 1 ? "y/" : "ies/");
   benchmark::RegisterBenchmark((name + std::to_string(K)).c_str(), [=](benchmark::State& st) {
-    drb::Scene scene;
+    const drb::Scene scene = drb::loadSceneFromUrdf(freeBodiesUrdf(bodies));
     std::vector<std::string> names;
-    for (std::size_t i = 0; i < bodies; ++i)
-    {
-      drb::SceneBody b;
-      b.body.name = "body" + std::to_string(i);
-      b.body.mass = body().mass;
-      b.body.inertia_body = body().inertia;
-      names.push_back(b.body.name);
-      scene.bodies.push_back(b);
-    }
+    for (const drb::BodyModel& b : scene.bodies)
+      names.push_back(b.name);
     const drb::SceneQueries queries(scene);
     const drb::SceneState current = queries.initialState();
     const std::vector<double>& packed = packedStates();

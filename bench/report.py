@@ -135,11 +135,12 @@ def section_inertia(inertia, docs):
 
 BENCH_SERVICE = "`~ping` / `~echo`: benchmark services (`~benchmark_services`), no query"
 SERVICE_NODE = {
-    "get_vertex_jacobians": "`SceneQueries::vertexJacobians` → `vertexPositionsAndJacobians`",
+    "get_vertex_jacobians": "`SceneQueries::vertexJacobians` → `vertexJacobians` → `vertexPositionsAndJacobians` (free object)",
     "compact_rotation_block": "`SceneQueries::vertexRotationJacobians<double>`",
     "compact_rotation_block_f32": "`SceneQueries::vertexRotationJacobians<float>`",
     "compact_positions_only": "`SceneQueries::vertexRotationJacobians<double>`, positions only",
-    "backprop": "`SceneQueries::backprop` → `backpropagateVertexGradients` (by coordinate)"}
+    "backprop": "`SceneQueries::backpropConfigurations` → `vertexBackprop` → `backpropagateVertexGradients` (free "
+                "object, by coordinate)"}
 
 
 def section_service(service, targets):
@@ -157,7 +158,7 @@ def section_service(service, targets):
     ping = t.get("ping")
     mm = t.get("get_mass_matrix")
     rows = []
-    mass = "`SceneQueries::massMatrices` → `massMatrixBatch`"
+    mass = "`SceneQueries::massMatrices` → `massMatrices` → `massMatrixBatch` (free object)"
     for name, label, node in (("ping", "~ping (empty)", BENCH_SERVICE),
                               ("get_mass_matrix", "~get_mass_matrix, 1 matrix", mass + " (1 state)"),
                               ("ping_nodelay", "~ping, client sockets with TCP_NODELAY", BENCH_SERVICE),

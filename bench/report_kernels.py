@@ -14,7 +14,7 @@ from report_format import (EPS, FLOOR, NOT_NODE, PEER, fmt_err, fmt_ratio, fmt_t
                            md_table, verdict)
 
 PATHS = (("avx512", "AVX-512F"), ("avx2", "AVX2 + FMA"), ("sse2", "SSE2"))
-NODE_BATCH = "yes: `SceneQueries::massMatrices` → `massMatrixBatch`"
+NODE_BATCH = "yes: `SceneQueries::massMatrices` → `massMatrices` → `massMatrixBatch` (free object)"
 
 
 def cpu(k, name):
@@ -102,7 +102,8 @@ def section_mass_matrix(k, acc, targets):
     return "\n".join(text)
 
 
-NODE_J = "yes: `SceneQueries::vertexJacobians` → `vertexPositionsAndJacobians` (SSE2, the only path)"
+NODE_J = ("yes: `SceneQueries::vertexJacobians` → `vertexJacobians` → `vertexPositionsAndJacobians` (free object; "
+          "SSE2, the only path)")
 JAC_METHODS = [
     ("node_positions_and_J", "ours, positions + J (168 B/vertex)", "ours_double", NODE_J),
     ("node_compact_rotation_block", "ours, positions + rotation block (96 B/vertex)", "ours_rotation_block_double",
@@ -231,7 +232,7 @@ def section_backprop(k, acc, targets, floor_rows):
     text = ["## 3. Backprop (vector-Jacobian product)",
             "",
             "dL/dq = Σ J_iᵀ g_i. Ours never forms J: W = Σ g_i p0_iᵀ and Σ g_i, then one 3×3 product "
-            "(`backpropFromSums`). **The node** (`SceneQueries::backprop`) keeps each body's vertices as x, y, z "
+            "(`backpropFromSums`). **The node** (`SceneQueries::backpropConfigurations` → `vertexBackprop`) keeps each body's vertices as x, y, z "
             "arrays made once at load (24 B per vertex) and sums by coordinate (`vertex_columns.h`, "
             "detail/backprop_sums.h): one load holds 8 vertices' x (AVX-512F) or 4 (AVX2 + FMA), chosen at run time "
             "from CPUID (AVX-512F on this machine); only the client's gradients are transposed in registers. An index "

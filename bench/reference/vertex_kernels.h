@@ -4,7 +4,7 @@
 // node runs the batched kernels.
 #pragma once
 
-#include "diff_rigid_body/body_pose.h"
+#include "diff_rigid_body/free_body/pose.h"
 #include "diff_rigid_body/types.h"
 
 namespace diff_rigid_body

@@ -1,0 +1,117 @@
+"""The targets of issues 18 (one body model: M, dM/dx, vertices) and 20
+(dynamics) for the targets table of docs/benchmarks.md, from the rows of
+report_articulated.py: one line per target, each robot's measured ratio,
+met only when every robot it names meets it."""
+from report_format import EPS, verdict
+
+LABELS = {"panda": "Panda", "ur5": "UR5", "humanoid": "humanoid", "humanoid_floating": "floating humanoid"}
+ARMS = ("panda", "ur5")
+ALL = ("panda", "ur5", "humanoid", "humanoid_floating")
+FEW_ULP = 8  # "a few ulp": at most 8 eps, as for the free body
+
+
+def quotient(a, b):
+    return a / b if a and b else None
+
+
+def target(rows, text, robots, value, ok, unit="×"):
+    """One line: `value(r)` per robot (None: not measured), met when ok(v) for all."""
+    measured, missed = [], []
+    for robot in robots:
+        if robot not in rows:
+            continue
+        v = value(rows[robot])
+        measured.append(f"{LABELS[robot]} {v:.3g}{unit}" if v is not None else f"{LABELS[robot]} n/a")
+        if v is None or not ok(v):
+            missed.append(LABELS[robot])
+    return [text, ", ".join(measured) or "n/a",
+            verdict(not missed and bool(measured), "not by " + ", ".join(missed) if missed else "")]
+
+
+def worst_error(r, keys):
+    """Largest of the errors `keys` in units of eps (None if any is missing)."""
+    values = [r.err(k) for k in keys]
+    return None if any(v is None for v in values) else max(values) / EPS
+
+
+def humanoid_line(rows, robot):
+    """The issue-18 rows of one humanoid against the Panda's and UR5's thresholds."""
+    if robot not in rows:
+        return None
+    r = rows[robot]
+    ours = r.t("mass_matrix", "ours")
+    checks = [("M vs Pinocchio", quotient(r.t("mass_matrix", "pinocchio"), ours), lambda v: v >= 1),
+              ("M vs KDL's longest chain", quotient(r.t("mass_matrix", "kdl"), ours), lambda v: v >= 4),
+              ("M vs MuJoCo", quotient(r.t("mass_matrix", "mujoco"), ours), lambda v: v >= 3),
+              ("dM/dx ÷ M", quotient(r.t("mass_matrix_derivatives", "ours"), ours), lambda v: v <= 4)]
+    if r.find("jacobian", "ours")[0]:
+        checks.append(("J ÷ write floor", quotient(r.find("jacobian", "ours")[0], r.find("jacobian", "floor_write")[0]),
+                       lambda v: v <= 2))
+        checks.append(("backprop ÷ read floor",
+                       quotient(r.find("backprop", "ours")[0], r.find("backprop", "floor_read")[0]), lambda v: v <= 1.5))
+    measured = ", ".join(f"{name} {v:.3g}×" if v is not None else f"{name} n/a" for name, v, _ in checks)
+    missed = [name for name, v, ok in checks if v is None or not ok(v)]
+    if not r.find("jacobian", "ours")[0]:
+        measured += " (no J or backprop rows: every vertex is on the static BODY)"
+    return [f"{LABELS[robot]}: M, dM/dx, J, backprop against KDL's longest chain and MuJoCo's whole tree "
+            "(the Panda's and UR5's thresholds)", measured,
+            verdict(not missed, "not " + ", ".join(missed) if missed else "")]
+
+
+def articulated_targets(rows):
+    t = lambda q, m: (lambda r: r.t(q, m))  # noqa: E731
+    ours_m = t("mass_matrix", "ours")
+    lines = [
+        target(rows, "Issue 18: M(x), pose included, faster than Pinocchio `crba` in the same run (Panda, UR5)", ARMS,
+               lambda r: quotient(r.t("mass_matrix", "pinocchio"), ours_m(r)), lambda v: v >= 1),
+        target(rows, "Issue 18: M(x) ≥ 4× faster than KDL `JntToMass` (Panda, UR5)", ARMS,
+               lambda r: quotient(r.t("mass_matrix", "kdl"), ours_m(r)), lambda v: v >= 4),
+        target(rows, "Issue 18: M(x) ≥ 3× faster than MuJoCo (Panda, UR5)", ARMS,
+               lambda r: quotient(r.t("mass_matrix", "mujoco"), ours_m(r)), lambda v: v >= 3),
+        target(rows, f"Issue 18: M(x) at a few ulp of MPFR (≤ {FEW_ULP} ε; Panda, UR5)", ARMS,
+               lambda r: worst_error(r, ["M.ours"]), lambda v: v <= FEW_ULP, " ε"),
+        target(rows, "Issue 18: dM/dx, all d matrices, ≤ 4× one M (Panda, UR5)", ARMS,
+               lambda r: quotient(r.t("mass_matrix_derivatives", "ours"), ours_m(r)), lambda v: v <= 4),
+        target(rows, "Issue 18: Panda, all vertices: positions + J ≤ 2× its write floor (pose included)", ("panda",),
+               lambda r: quotient(r.find("jacobian", "ours")[0], r.find("jacobian", "floor_write")[0]),
+               lambda v: v <= 2),
+        target(rows, "Issue 18: Panda, all vertices: backprop ≤ 1.5× its read floor (pose included)", ("panda",),
+               lambda r: quotient(r.find("backprop", "ours")[0], r.find("backprop", "floor_read")[0]),
+               lambda v: v <= 1.5),
+        target(rows, "Issue 18: the node's whole call (SceneQueries) ≤ 1.2× the kernel it runs: M", ALL,
+               lambda r: quotient(r.t("mass_matrix", "node_call"), ours_m(r)), lambda v: v <= 1.2),
+        target(rows, "Issue 18: the node's whole call (SceneQueries) ≤ 1.2× the kernel it runs: backprop",
+               [x for x in ALL if x in rows and rows[x].find("backprop", "ours")[0]],
+               lambda r: quotient(r.find("backprop", "node_call")[0], r.find("backprop", "ours")[0]),
+               lambda v: v <= 1.2),
+    ]
+    lines += [line for line in (humanoid_line(rows, "humanoid"), humanoid_line(rows, "humanoid_floating")) if line]
+    faster = lambda q, peer: (lambda r: quotient(r.t(q, peer), r.t(q, "ours")))  # noqa: E731
+    lines += [
+        target(rows, "Issue 20: inverse dynamics at least as fast as Pinocchio `rnea`", ALL,
+               faster("inverse_dynamics", "pinocchio"), lambda v: v >= 1),
+        target(rows, "Issue 20: ∂τ/∂x and ∂τ/∂ẋ together at least as fast as `computeRNEADerivatives`", ALL,
+               faster("inverse_dynamics_derivatives", "pinocchio"), lambda v: v >= 1),
+        target(rows, "Issue 20: forward dynamics at least as fast as Pinocchio `aba`", ALL,
+               faster("forward_dynamics", "pinocchio"), lambda v: v >= 1),
+        target(rows, "Issue 20: forward-dynamics derivatives at least as fast as `computeABADerivatives`", ALL,
+               faster("forward_dynamics_derivatives", "pinocchio"), lambda v: v >= 1),
+        target(rows, "Issue 20: inverse dynamics ≥ 2× faster than KDL `ChainIdSolver_RNE` (humanoid: its longest "
+               "chain)", ALL, faster("inverse_dynamics", "kdl"), lambda v: v >= 2),
+        target(rows, "Issue 20: inverse dynamics ≥ 1.5× faster than MuJoCo (`mj_rne` pipeline)", ALL,
+               faster("inverse_dynamics", "mujoco"), lambda v: v >= 1.5),
+        target(rows, "Issue 20: ∂τ/∂x + ∂τ/∂ẋ ≤ 6× one inverse dynamics", ALL,
+               lambda r: quotient(r.t("inverse_dynamics_derivatives", "ours"), r.t("inverse_dynamics", "ours")),
+               lambda v: v <= 6),
+        target(rows, "Issue 20: forward dynamics ≤ 1.5× one M", ALL,
+               lambda r: quotient(r.t("forward_dynamics", "ours"), ours_m(r)), lambda v: v <= 1.5),
+        target(rows, "Issue 20: forward-dynamics derivatives ≤ 10× one forward dynamics", ALL,
+               lambda r: quotient(r.t("forward_dynamics_derivatives", "ours"), r.t("forward_dynamics", "ours")),
+               lambda v: v <= 10),
+        target(rows, f"Issue 20: τ and ẍ within a few ulp of MPFR (≤ {FEW_ULP} ε, the worse of the two)", ALL,
+               lambda r: worst_error(r, ["tau.ours", "fd.ours"]), lambda v: v <= FEW_ULP, " ε"),
+        target(rows, f"Issue 20: ∂τ/∂x, ∂τ/∂ẋ, ∂ẍ/∂x, ∂ẍ/∂ẋ, M⁻¹ within a few ulp of MPFR (≤ {FEW_ULP} ε, the worst)",
+               ALL, lambda r: worst_error(r, ["dtau_dx.ours", "dtau_dxd.ours", "dfd_dx.ours", "dfd_dxd.ours",
+                                              "minv.ours"]), lambda v: v <= FEW_ULP, " ε"),
+    ]
+    return lines
