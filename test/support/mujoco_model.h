@@ -82,6 +82,8 @@ public:
   Model& operator=(const Model&) = delete;
 
   const mjModel& model() const { return *model_; }
+  /// For tests that set gravity or clear passive forces.
+  mjModel& mutableModel() { return *model_; }
   mjData& data() { return *data_; }
 
   /// Index of the joint named `name`, or -1.
