@@ -279,7 +279,8 @@ def main():
             "```",
             "",
             "Every figure is measured in the same run as the peers it is compared with: KDL "
-            "(`liborocos-kdl-dev`) and MuJoCo (`libmujoco-dev`). Kernel times are medians over "
+            "(`liborocos-kdl-dev`), MuJoCo (`libmujoco-dev`) and, for bodies with joints, Pinocchio 3.7.0 "
+            "(vendored in bench/third_party). Kernel times are medians over "
             f"{repetitions} repetitions, run in random interleaved order (a slow phase of the machine "
             "lands on every method alike), of Google Benchmark's **CPU time** per operation (robust on a shared machine; the JSON in the "
             "results folder also has wall time). Errors are maxima of the relative error against a 256-bit "

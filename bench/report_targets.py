@@ -25,7 +25,7 @@ def target(rows, text, robots, value, ok, unit="×"):
         if v is None or not ok(v):
             missed.append(LABELS[robot])
     return [text, ", ".join(measured) or "n/a",
-            verdict(not missed and bool(measured), "not by " + ", ".join(missed) if missed else "")]
+            verdict(not missed and bool(measured), "not met by " + ", ".join(missed) if missed else "")]
 
 
 def worst_error(r, keys):
@@ -55,7 +55,7 @@ def humanoid_line(rows, robot):
         measured += " (no J or backprop rows: every vertex is on the static BODY)"
     return [f"{LABELS[robot]}: M, dM/dx, J, backprop against KDL's longest chain and MuJoCo's whole tree "
             "(the Panda's and UR5's thresholds)", measured,
-            verdict(not missed, "not " + ", ".join(missed) if missed else "")]
+            verdict(not missed, "not met: " + ", ".join(missed) if missed else "")]
 
 
 def articulated_targets(rows):
