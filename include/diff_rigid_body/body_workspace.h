@@ -45,6 +45,7 @@ struct BodyWorkspace
     derivative_x.resize(static_cast<Eigen::Index>(d), static_cast<Eigen::Index>(d));
     derivative_xd.resize(static_cast<Eigen::Index>(d), static_cast<Eigen::Index>(d));
     inverse_mass.resize(static_cast<Eigen::Index>(d), static_cast<Eigen::Index>(d));
+    factor_rows.resize(static_cast<Eigen::Index>(d), static_cast<Eigen::Index>(d));
     solution.resize(static_cast<Eigen::Index>(d));
     segment_sums.resize(n);
     column_motion.assign(6 * d, 0.0);
@@ -102,7 +103,8 @@ struct BodyWorkspace
   std::vector<Force<Scalar>> momentum_rate;  ///< per dof: what its velocity adds to the subtree force above it
 
   // ---- forward_dynamics.h ----
-  MatrixX factor;    ///< d x d: M's factorization (tree_factorization.h)
+  MatrixX factor;       ///< d x d: M's factorization (tree_factorization.h)
+  MatrixX factor_rows;  ///< d x d: scratch of solveMassMatrixColumns
   VectorX solution;  ///< d
   /// d x d each: d(tau or x'')/dx, d(tau or x'')/dx', M^-1, for the node's answers.
   MatrixX derivative_x, derivative_xd, inverse_mass;

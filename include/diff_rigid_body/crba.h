@@ -22,19 +22,21 @@ namespace diff_rigid_body
 {
 namespace detail
 {
-/// ws.composite: each segment's subtree inertia about ws.r, children first.
+/// ws.body_inertia: each segment's own inertia about ws.r; ws.composite:
+/// its subtree's, children first.
 template <typename Scalar>
 void compositeInertias(const BodyModel& model, BodyWorkspace<Scalar>& ws)
 {
   for (std::size_t s = model.segments.size(); s-- > 0;)
   {
     const Segment& segment = model.segments[s];
-    Inertia<Scalar>& composite = ws.composite[s];
+    Inertia<Scalar>& own = ws.body_inertia[s];
     if (segment.inertia.mass > 0.0)
-      composite = spatial::inertiaAbout(ws.r, ws.R[s], ws.p[s], segment.inertia.mass, segment.inertia.com,
-                                        segment.inertia.inertia);
+      own = spatial::inertiaAbout(ws.r, ws.R[s], ws.p[s], segment.inertia.mass, segment.inertia.com,
+                                  segment.inertia.inertia);
     else
-      composite = Inertia<Scalar>();
+      own = Inertia<Scalar>();
+    ws.composite[s] = own;
   }
   for (std::size_t s = model.segments.size(); s-- > 1;)
     spatial::add(ws.composite[static_cast<std::size_t>(model.segments[s].parent)], ws.composite[s]);
@@ -42,7 +44,7 @@ void compositeInertias(const BodyModel& model, BodyWorkspace<Scalar>& ws)
 }  // namespace detail
 
 /// M(x) into ws.M (d x d, symmetric) from the kinematics already in ws
-/// (forwardKinematics); also leaves ws.composite and ws.momentum.
+/// (forwardKinematics); also leaves ws.body_inertia, ws.composite and ws.momentum.
 template <typename Scalar>
 void crbaFromKinematics(const BodyModel& model, BodyWorkspace<Scalar>& ws)
 {

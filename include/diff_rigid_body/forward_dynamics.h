@@ -24,7 +24,8 @@ int forwardDynamics(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Sca
                     const Scalar* tau, const Vector3<Scalar>& gravity, Scalar* xdd)
 {
   crba(model, ws, x);
-  inverseDynamicsFromKinematics(model, ws, xd, static_cast<const Scalar*>(nullptr), gravity, xdd);  // c + g
+  inverseDynamicsFromKinematics(model, ws, xd, static_cast<const Scalar*>(nullptr), gravity, xdd,
+                                /*inertias_ready=*/true);  // c + g
   const int singular = factorMassMatrix(model, ws);
   if (singular >= 0)
     return singular;
@@ -51,12 +52,9 @@ int forwardDynamicsDerivatives(const BodyModel& model, BodyWorkspace<Scalar>& ws
   inverseDynamicsDerivatives(model, ws, x, xd, xdd, gravity, dxdd_dx, dxdd_dxd);
   const Eigen::Index d = static_cast<Eigen::Index>(model.coordinates);
   inverse_mass.setIdentity(d, d);
-  for (Eigen::Index c = 0; c < d; ++c)
-  {
-    solveMassMatrix(model, ws, inverse_mass.col(c).data());
-    solveMassMatrix(model, ws, dxdd_dx.col(c).data());
-    solveMassMatrix(model, ws, dxdd_dxd.col(c).data());
-  }
+  solveMassMatrixColumns(model, ws, inverse_mass);
+  solveMassMatrixColumns(model, ws, dxdd_dx);
+  solveMassMatrixColumns(model, ws, dxdd_dxd);
   dxdd_dx = -dxdd_dx;
   dxdd_dxd = -dxdd_dxd;
   return -1;

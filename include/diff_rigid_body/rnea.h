@@ -109,11 +109,15 @@ void accumulateForces(const BodyModel& model, BodyWorkspace<Scalar>& ws, Scalar*
 /// tau = M(x) x'' + c(x, x') + g(x) into `tau` (d values) from the
 /// kinematics in ws (forwardKinematics at x). A null xd or xdd means zeros.
 /// gravity: gamma in the fixed frame [m/s^2].
+/// `inertias_ready`: ws.body_inertia already holds them for this kinematics
+/// (crba computed them).
 template <typename Scalar>
 void inverseDynamicsFromKinematics(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Scalar* xd,
-                                   const Scalar* xdd, const Vector3<Scalar>& gravity, Scalar* tau)
+                                   const Scalar* xdd, const Vector3<Scalar>& gravity, Scalar* tau,
+                                   bool inertias_ready = false)
 {
-  detail::segmentInertias(model, ws);
+  if (!inertias_ready)
+    detail::segmentInertias(model, ws);
   detail::propagateMotion(model, ws, xd, xdd, gravity);
   detail::accumulateForces(model, ws, tau);
 }

@@ -122,8 +122,8 @@ void inverseDynamicsDerivatives(const BodyModel& model, BodyWorkspace<Scalar>& w
                                 typename BodyWorkspace<Scalar>::MatrixX& dtau_dxd)
 {
   forwardKinematics(model, ws, x);
-  inverseDynamicsFromKinematics(model, ws, xd, xdd, gravity, ws.tau.data());
   detail::compositeInertias(model, ws);
+  inverseDynamicsFromKinematics(model, ws, xd, xdd, gravity, ws.tau.data(), /*inertias_ready=*/true);
   detail::velocityRates(model, ws);
   std::vector<Force<Scalar>>& moved_rate = ws.momentum_rate;
   detail::dofDerivativeTerms(model, ws, moved_rate);

@@ -94,4 +94,32 @@ void solveMassMatrix(const BodyModel& model, BodyWorkspace<Scalar>& ws, Scalar* 
     b[model.factor_coordinate[static_cast<std::size_t>(k)]] = y[k];
 }
 
+/// Solves M Y = B in place for every column of B (d x n, x order in rows),
+/// with the factorization in ws: the same walks as solveMassMatrix, each
+/// step a whole row of B at once (ws.factor_rows is the scratch, factor
+/// rows as its columns, so every update is contiguous).
+template <typename Scalar>
+void solveMassMatrixColumns(const BodyModel& model, BodyWorkspace<Scalar>& ws,
+                            typename BodyWorkspace<Scalar>::MatrixX& B)
+{
+  const int d = static_cast<int>(model.coordinates);
+  const auto& H = ws.factor;
+  auto& Y = ws.factor_rows;  // column k = row k of the system in factorization order
+  const auto parent = [&](int k) { return model.factor_parent[static_cast<std::size_t>(k)]; };
+  const auto coordinate = [&](int k) { return static_cast<Eigen::Index>(model.factor_coordinate[static_cast<std::size_t>(k)]); };
+  Y.resize(B.cols(), d);
+  for (int k = 0; k < d; ++k)
+    Y.col(k) = B.row(coordinate(k)).transpose();
+  for (int k = d - 1; k >= 0; --k)  // L^T Z = B
+    for (int j = parent(k); j >= 0; j = parent(j))
+      Y.col(j) -= H(k, j) * Y.col(k);
+  for (int k = 0; k < d; ++k)  // D W = Z
+    Y.col(k) /= H(k, k);
+  for (int k = 0; k < d; ++k)  // L Y = W
+    for (int j = parent(k); j >= 0; j = parent(j))
+      Y.col(k) -= H(k, j) * Y.col(j);
+  for (int k = 0; k < d; ++k)
+    B.row(coordinate(k)) = Y.col(k).transpose();
+}
+
 }  // namespace diff_rigid_body

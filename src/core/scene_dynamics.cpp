@@ -132,8 +132,8 @@ void SceneQueries::inverseDynamics(const SceneState& current, const std::vector<
       diff_rigid_body::inverseDynamics(body, ws, x, xd, static_cast<const double*>(nullptr), no_gravity,
                                        answer.velocity_terms.data() + v);
       inverseDynamicsFromKinematics(body, ws, static_cast<const double*>(nullptr), static_cast<const double*>(nullptr),
-                                    gravity_, answer.gravity_terms.data() + v);
-      inverseDynamicsFromKinematics(body, ws, xd, xdd, gravity_, answer.tau.data() + v);
+                                    gravity_, answer.gravity_terms.data() + v, /*inertias_ready=*/true);
+      inverseDynamicsFromKinematics(body, ws, xd, xdd, gravity_, answer.tau.data() + v, /*inertias_ready=*/true);
       if (matrices > 0)
       {
         inverseDynamicsDerivatives(body, ws, x, xd, xdd, gravity_, ws.derivative_x, ws.derivative_xd);

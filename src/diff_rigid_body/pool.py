@@ -223,7 +223,7 @@ class RigidBodyPool(RigidBodyClient):
                 raise self._all_down('%s/%s failed' % (self.server, name))
             start, stop = pending.pop(0)  # one range per round: an instance has one call in flight
             pending += self._run(name, K, self._cut(name, message, K, start, stop, live), answers)
-        if K is None:
+        if K is None or len(answers) == 1:
             return answers[0]
         return JoinedResponse(name, [answers[start] for start in sorted(answers)])
 
@@ -231,10 +231,12 @@ class RigidBodyPool(RigidBodyClient):
         """[(instance, start, stop, message)]: configurations [start, stop) over the live
         instances by throughput, or the whole (unsharded) message to the fastest one."""
         known = [rate for instance in live for rate in [instance.rates.get(name)] if rate]
-        default = float(np.mean(known)) if known else 1.0
+        default = sum(known) / len(known) if known else 1.0
         weights = [instance.rate(name, default) for instance in live]
         if K is None:
-            return [(live[int(np.argmax(weights))], 0, None, message)]
+            return [(live[weights.index(max(weights))], 0, None, message)]
+        if len(live) == 1 and (start, stop) == (0, K):
+            return [(live[0], 0, K, message)]
         pieces = []
         for instance, count in zip(live, apportion(stop - start, weights)):
             if count:
