@@ -1,7 +1,9 @@
 #!/usr/bin/python3
 """Throughput of diff_rigid_body.RigidBodyPool over 1, 2 and 4 instances on this machine.
 
-    source $DRB_WORKSPACE/devel/setup.bash && bench/pool_throughput.py     # writes docs/benchmarks_pool.md
+    source $DRB_WORKSPACE/devel/setup.bash && bench/pool_throughput.py --output pool.md
+
+(scripts/bench runs it and puts its report in docs/benchmarks.md, "Several instances").
 
 Starts its own master on a free port and four rigid_body_server instances per scene (separate
 processes, ~benchmark_services on), then, for each workload and each pool size, runs back-to-back
@@ -14,8 +16,7 @@ load the machine was under). Workloads (K = 1000 configurations per call):
 Every pool answer is checked bit for bit against one instance's. Also measured: the same bytes
 echoed by the nodes (~echo: the transport alone, split in n streams as a pool of n splits them),
 the CPU each process used,
-one instance killed mid-call (failover), and bench/client_trajectory.py (the client's batched
-trajectory gradient against per-frame calls). The report and the N-host model: bench/pool_report.py.
+and one instance killed mid-call (failover). The report and the N-host model: bench/pool_report.py.
 """
 import argparse
 import os
@@ -264,24 +265,11 @@ def measure_scene(graph, scene, urdf, args):
     return results, failover
 
 
-def client_trajectory(graph, folder):
-    """bench/client_trajectory.py on the default scene (both transports, and the echo floor)."""
-    graph.instance('/trajectory', os.path.join(REPO, 'urdf/demo_scene.urdf'))
-    wait_for(['/trajectory'])
-    output = os.path.join(folder, 'client_trajectory.md')
-    subprocess.run([sys.executable, os.path.join(HERE, 'client_trajectory.py'), '--server',
-                    '/trajectory/rigid_body_server', '--transports', 'tcpros', 'rospy', '--floor', '--output', output],
-                   check=True, stdout=subprocess.DEVNULL)
-    with open(output) as f:
-        return f.read()
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument('--seconds', type=float, default=3.0, help='length of one measurement window [s]')
     parser.add_argument('--repeats', type=int, default=3, help='windows per pool size (median reported)')
-    parser.add_argument('--output', default=os.path.join(REPO, 'docs', 'benchmarks_pool.md'))
-    parser.add_argument('--skip-trajectory', action='store_true', help='leave out bench/client_trajectory.py')
+    parser.add_argument('--output', required=True, help='markdown report to write')
     args = parser.parse_args()
     start = time.monotonic()
     with tempfile.TemporaryDirectory(prefix='drb_pool_bench_') as folder:
@@ -290,12 +278,11 @@ def main():
             scenes = {}
             for scene, urdf in (('panda', PANDA), ('humanoid', floating_humanoid(folder))):
                 scenes[scene] = measure_scene(graph, scene, urdf, args)
-            trajectory = None if args.skip_trajectory else client_trajectory(graph, folder)
         finally:
             graph.stop()
     machine = '%s, %d cores, Python %s; writing fresh memory costs %.1f us per 4 KiB page' % (
         platform.machine(), os.cpu_count(), platform.python_version(), first_touch_cost())
-    text = pool_report.report(scenes, trajectory, args, machine, time.monotonic() - start)
+    text = pool_report.report(scenes, args, machine, time.monotonic() - start)
     with open(args.output, 'w') as f:
         f.write(text)
     print(text)

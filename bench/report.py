@@ -263,6 +263,9 @@ def main():
     client_path = os.path.join(args.results, "client_trajectory.md")  # written by bench/client_trajectory.py
     if os.path.exists(client_path):
         parts.append(open(client_path).read().strip())
+    pool_path = os.path.join(args.results, "pool.md")  # written by bench/pool_throughput.py
+    if os.path.exists(pool_path):
+        parts.append(open(pool_path).read().strip())
     plot_kernels(k, acc, args.docs)
 
     info = machine(args.workspace, kernels_json, args.repo, args.results)

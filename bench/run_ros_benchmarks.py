@@ -262,12 +262,14 @@ def run_client_trajectory(args, env, master):
     """bench/client_trajectory.py (PyTorch through the Python client) against the node on the default scene."""
     here = os.path.dirname(os.path.abspath(__file__))
     urdf = os.path.join(here, "..", "urdf", "demo_scene.urdf")
-    node = start_node(args, env, urdf, os.path.join(args.out, "node_client_trajectory.log"))
+    node = start_node(args, env, urdf, os.path.join(args.out, "node_client_trajectory.log"),
+                      ["_benchmark_services:=true"])
     try:
         wait_for(lambda: master.has_service("/rigid_body_server/backprop"), 300, "the node", node)
         log("client trajectories: node up; running bench/client_trajectory.py")
         client = subprocess.run([sys.executable, os.path.join(here, "client_trajectory.py"), "--server",
-                                 "/rigid_body_server", "--output", os.path.join(args.out, "client_trajectory.md")],
+                                 "/rigid_body_server", "--transports", "tcpros", "rospy", "--floor",
+                                 "--output", os.path.join(args.out, "client_trajectory.md")],
                                 env=env)
         if client.returncode != 0:
             raise RuntimeError(f"client_trajectory.py exited with {client.returncode}")

@@ -11,8 +11,8 @@ fields serialised by genpy's generated ``serialize_numpy``/``deserialize_numpy``
   of that buffer (no copy either).
 
 rospy stages both directions in a ``BytesIO`` that it shrinks to empty after every message, so
-each large call maps and faults fresh pages (docs/benchmarks_pool.md measures it: the same 1.5 MB
-echo takes ~20x longer through rospy on a VM where a page fault costs ~30 us). Not thread-safe:
+each large call maps and faults fresh pages (docs/benchmarks.md, "Client (PyTorch) trajectories",
+times both transports on the same bytes). Not thread-safe:
 one connection per thread.
 """
 import socket
