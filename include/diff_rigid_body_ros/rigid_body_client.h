@@ -40,6 +40,7 @@
 #include <diff_rigid_body/SetState.h>
 
 #include "diff_rigid_body_ros/client_arrays.h"
+#include "diff_rigid_body_ros/client_requests.h"
 #include "diff_rigid_body_ros/client_responses.h"
 
 namespace diff_rigid_body_ros
@@ -95,10 +96,7 @@ public:
   MassMatrices massMatrices(const std::vector<std::string>& bodies = {}, const std::vector<double>& q = {},
                             bool derivatives = false)
   {
-    diff_rigid_body::GetMassMatrix srv;
-    srv.request.bodies = bodies;
-    srv.request.q = q;
-    srv.request.derivatives = derivatives;
+    auto srv = detail::massMatrixRequest(bodies, q, derivatives);
     call("get_mass_matrix", srv);
     return toMassMatrices(srv.response, derivatives);
   }
@@ -119,13 +117,7 @@ public:
                                         const std::vector<std::string>& bodies = {}, bool coriolis_matrices = false,
                                         bool derivatives = false)
   {
-    diff_rigid_body::InverseDynamics srv;
-    srv.request.bodies = bodies;
-    srv.request.q = q;
-    srv.request.qdot = qdot;
-    srv.request.qddot = qddot;
-    srv.request.coriolis_matrices = coriolis_matrices;
-    srv.request.derivatives = derivatives;
+    auto srv = detail::inverseDynamicsRequest(bodies, q, qdot, qddot, coriolis_matrices, derivatives);
     call("inverse_dynamics", srv);
     return toInverseDynamics(srv.response);
   }
@@ -147,12 +139,7 @@ public:
                                         const std::vector<double>& tau = {},
                                         const std::vector<std::string>& bodies = {}, bool derivatives = false)
   {
-    diff_rigid_body::ForwardDynamics srv;
-    srv.request.bodies = bodies;
-    srv.request.q = q;
-    srv.request.qdot = qdot;
-    srv.request.tau = tau;
-    srv.request.derivatives = derivatives;
+    auto srv = detail::forwardDynamicsRequest(bodies, q, qdot, tau, derivatives);
     call("forward_dynamics", srv);
     return toForwardDynamics(srv.response);
   }
@@ -306,10 +293,7 @@ private:
                                                       const std::vector<std::uint32_t>& vertices,
                                                       std::vector<double> q, std::size_t K)
   {
-    diff_rigid_body::GetVertexJacobians srv;
-    srv.request.body = body;
-    srv.request.vertices = vertices;
-    srv.request.q = std::move(q);
+    auto srv = detail::vertexJacobiansRequest(body, vertices, std::move(q));
     call("get_vertex_jacobians", srv);
     return toVertexJacobians(srv.response, K);
   }
@@ -332,11 +316,7 @@ private:
                                                const std::vector<const Eigen::Matrix3Xd*>& dL_dp,
                                                std::vector<double> q, std::size_t K)
   {
-    diff_rigid_body::Backprop srv;
-    srv.request.body = body;
-    srv.request.vertices = vertices;
-    srv.request.gradients = detail::flattenGradients(dL_dp);
-    srv.request.q = std::move(q);
+    auto srv = detail::backpropRequest(body, vertices, detail::flattenGradients(dL_dp), std::move(q));
     call("backprop", srv);
     return toGradients(srv.response, K);
   }

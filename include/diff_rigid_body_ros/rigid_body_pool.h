@@ -33,6 +33,7 @@
 
 #include <ros/ros.h>
 
+#include "diff_rigid_body_ros/client_requests.h"
 #include "diff_rigid_body_ros/client_responses.h"
 #include "diff_rigid_body_ros/pool_shards.h"
 #include "diff_rigid_body_ros/pool_instances.h"
@@ -67,10 +68,7 @@ public:
   MassMatrices massMatrices(const std::vector<std::string>& bodies, const std::vector<double>& q,
                             bool derivatives = false)
   {
-    diff_rigid_body::GetMassMatrix srv;
-    srv.request.bodies = bodies;
-    srv.request.q = q;
-    srv.request.derivatives = derivatives;
+    auto srv = detail::massMatrixRequest(bodies, q, derivatives);
     call(srv);
     return toMassMatrices(srv.response, derivatives);
   }
@@ -80,13 +78,7 @@ public:
                                         const std::vector<std::string>& bodies = {}, bool coriolis_matrices = false,
                                         bool derivatives = false)
   {
-    diff_rigid_body::InverseDynamics srv;
-    srv.request.bodies = bodies;
-    srv.request.q = q;
-    srv.request.qdot = qdot;
-    srv.request.qddot = qddot;
-    srv.request.coriolis_matrices = coriolis_matrices;
-    srv.request.derivatives = derivatives;
+    auto srv = detail::inverseDynamicsRequest(bodies, q, qdot, qddot, coriolis_matrices, derivatives);
     call(srv);
     return toInverseDynamics(srv.response);
   }
@@ -95,12 +87,7 @@ public:
                                         const std::vector<double>& tau = {},
                                         const std::vector<std::string>& bodies = {}, bool derivatives = false)
   {
-    diff_rigid_body::ForwardDynamics srv;
-    srv.request.bodies = bodies;
-    srv.request.q = q;
-    srv.request.qdot = qdot;
-    srv.request.tau = tau;
-    srv.request.derivatives = derivatives;
+    auto srv = detail::forwardDynamicsRequest(bodies, q, qdot, tau, derivatives);
     call(srv);
     return toForwardDynamics(srv.response);
   }
@@ -108,10 +95,7 @@ public:
   std::vector<VertexJacobians> vertexJacobians(const std::string& body, const std::vector<Eigen::VectorXd>& qs,
                                                const std::vector<std::uint32_t>& vertices = {})
   {
-    diff_rigid_body::GetVertexJacobians srv;
-    srv.request.body = body;
-    srv.request.vertices = vertices;
-    srv.request.q = detail::flatten(qs);
+    auto srv = detail::vertexJacobiansRequest(body, vertices, detail::flatten(qs));
     call(srv);
     return toVertexJacobians(srv.response, qs.size());
   }
@@ -123,11 +107,7 @@ public:
     if (dL_dp.size() != qs.size())
       throw std::invalid_argument("backprop: " + std::to_string(dL_dp.size()) + " gradient blocks for " +
                                   std::to_string(qs.size()) + " configurations");
-    diff_rigid_body::Backprop srv;
-    srv.request.body = body;
-    srv.request.vertices = vertices;
-    srv.request.gradients = detail::flattenGradients(dL_dp);
-    srv.request.q = detail::flatten(qs);
+    auto srv = detail::backpropRequest(body, vertices, detail::flattenGradients(dL_dp), detail::flatten(qs));
     call(srv);
     return toGradients(srv.response, qs.size());
   }

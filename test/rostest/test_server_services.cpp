@@ -448,7 +448,7 @@ TEST_F(GimbalLock, FiniteAnswersAndCosThetaReported)
     ASSERT_EQ(mass.cos_theta.size(), 1u);
     ASSERT_EQ(mass.M.size(), 1u);
     ASSERT_TRUE(mass.M[0].allFinite());
-    for (const Matrix6d& dM : mass.dM.at(0))
+    for (const Eigen::MatrixXd& dM : mass.dM.at(0))
       ASSERT_TRUE(dM.allFinite());
     EXPECT_EQ(mass.cos_theta[0], std::cos(theta));  // 1e-9 or 6.12e-17: reported, not rounded to 0
     EXPECT_GT(mass.cos_theta[0], 0.0);
