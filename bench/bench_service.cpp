@@ -10,8 +10,9 @@
 // `services` times, per call (median and quartiles over repeated calls):
 // ~ping; ~get_mass_matrix (one matrix, and K = 1000 configurations);
 // for each body: ~get_vertex_jacobians, ~backprop and the reduced
-// transports of ~get_vertex_jacobians_compact, each next to ~echo moving the
-// same number of payload bytes each way, plus the error of the reduced
+// transports of ~get_vertex_jacobians_compact, and ~inverse_dynamics and
+// ~forward_dynamics of one body (K = 1, and K = 1000 with derivatives), each next
+// to ~echo moving the same number of payload bytes each way, plus the error of the reduced
 // transports against the full answer. `tf_sink` subscribes to /tf and counts
 // what arrives (the scene-scale benchmark uses it as the tf consumer).
 #include <netinet/in.h>
@@ -35,10 +36,12 @@
 
 #include <diff_rigid_body/Backprop.h>
 #include <diff_rigid_body/Echo.h>
+#include <diff_rigid_body/ForwardDynamics.h>
 #include <diff_rigid_body/GetBodies.h>
 #include <diff_rigid_body/GetMassMatrix.h>
 #include <diff_rigid_body/GetVertexJacobians.h>
 #include <diff_rigid_body/GetVertexJacobiansCompact.h>
+#include <diff_rigid_body/InverseDynamics.h>
 #include <diff_rigid_body/Ping.h>
 
 namespace
@@ -131,6 +134,62 @@ template <typename Service>
 std::function<bool()> caller(ros::ServiceClient& client, Service& srv)
 {
   return [&client, &srv] { return client.call(srv) && srv.response.success; };
+}
+
+/// Times `call` alternately with ~echo carrying `request_values` doubles up and `response_values`
+/// down (the call's array payload), and appends both timings.
+void timeAgainstEcho(const std::string& name, const std::function<bool()>& call, std::size_t request_values,
+                     std::size_t response_values, ros::ServiceClient& echo_client, double budget,
+                     std::vector<Timing>& timings)
+{
+  diff_rigid_body::Echo echo;
+  echo.request.data.assign(request_values, 0.5);
+  echo.request.response_size = static_cast<std::uint32_t>(response_values);
+  auto [t, e] = timePair(name, call, "echo_for_" + name, caller(echo_client, echo), budget);
+  t.request_bytes = e.request_bytes = 8 * request_values;
+  t.response_bytes = e.response_bytes = 8 * response_values;
+  timings.push_back(t);
+  timings.push_back(e);
+}
+
+/// ~inverse_dynamics and ~forward_dynamics of one free body (6 coordinates): K = 1 without
+/// derivatives, K = 1000 with them; configurations with |theta| <= 1 (M regular).
+void timeDynamics(ros::NodeHandle& nh, const std::string& ns, const std::string& body,
+                  ros::ServiceClient& echo_client, double budget, std::vector<Timing>& timings)
+{
+  auto id_client = persistentClient<diff_rigid_body::InverseDynamics>(nh, ns + "inverse_dynamics");
+  auto fd_client = persistentClient<diff_rigid_body::ForwardDynamics>(nh, ns + "forward_dynamics");
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const auto values = [&](std::size_t count) {
+    std::vector<double> v(count);
+    for (double& x : v)
+      x = u(rng);
+    return v;
+  };
+  for (const std::size_t K : { std::size_t(1), std::size_t(1000) })
+  {
+    const bool derivatives = K > 1;
+    const std::string suffix = "/K" + std::to_string(K);
+    diff_rigid_body::InverseDynamics id;
+    id.request.bodies = { body };
+    id.request.q = values(6 * K);
+    id.request.qdot = values(6 * K);
+    id.request.qddot = values(6 * K);
+    id.request.derivatives = derivatives;
+    // per configuration: tau, c, g (6 each), cos(theta); with derivatives dtau/dx, dtau/dx' (36 each)
+    timeAgainstEcho("inverse_dynamics" + suffix, caller(id_client, id), 18 * K, (19 + (derivatives ? 72 : 0)) * K,
+                    echo_client, budget, timings);
+    diff_rigid_body::ForwardDynamics fd;
+    fd.request.bodies = id.request.bodies;
+    fd.request.q = id.request.q;
+    fd.request.qdot = id.request.qdot;
+    fd.request.tau = values(6 * K);
+    fd.request.derivatives = derivatives;
+    // per configuration: x'' (6), cos(theta); with derivatives dx''/dx, dx''/dx', M^-1 (36 each)
+    timeAgainstEcho("forward_dynamics" + suffix, caller(fd_client, fd), 18 * K, (7 + (derivatives ? 108 : 0)) * K,
+                    echo_client, budget, timings);
+  }
 }
 
 int runServices(const std::string& out_path, double budget)
@@ -275,6 +334,7 @@ int runServices(const std::string& out_path, double budget)
     timings.push_back(tbe);
     std::fprintf(stderr, "drb_bench_service: %s (%zu vertices) done\n", body.c_str(), n);
   }
+  timeDynamics(nh, ns, bodies.response.names.front(), echo_client, budget, timings);
 
   // TCP_NODELAY on every connection of this client, then the small calls again.
   const int sockets = setNoDelayOnAllSockets();

@@ -202,12 +202,37 @@ def section_service(service, targets):
              "product path; it is the reference each service is timed against.", "",
              md_table(["vertices", "service", "node runs", "payload", "service", "echo", "÷ echo", "payload rate",
                        "reduced transport error vs full answer"], rows)]
+    text += section_dynamics_services(t, us, targets)
     for svc in ("get_vertex_jacobians", "backprop"):
         if worst[svc]:
             r = worst[svc]
             targets.append([f"{svc} ≤ 1.5× the same-size echo (worst size)", f"{r:.3g}×",
                             verdict(r <= 1.5, "" if r <= 1.5 else f"over by {r / 1.5:.2g}×")])
     return "\n".join(text)
+
+
+def section_dynamics_services(t, us, targets):
+    """~inverse_dynamics and ~forward_dynamics of one free body against a same-size echo."""
+    rows, worst = [], 0.0
+    for name, label in (("inverse_dynamics/K1", "inverse_dynamics, K = 1"),
+                        ("forward_dynamics/K1", "forward_dynamics, K = 1"),
+                        ("inverse_dynamics/K1000", "inverse_dynamics, K = 1000, derivatives"),
+                        ("forward_dynamics/K1000", "forward_dynamics, K = 1000, derivatives")):
+        x, e = t.get(name), t.get("echo_for_" + name)
+        if not x or not e:
+            continue
+        r = x["median_s"] / e["median_s"]
+        worst = max(worst, r)
+        rows.append([label, f"{x['request_bytes'] / 1e3:.3g} kB up, {x['response_bytes'] / 1e3:.3g} kB down",
+                     us(x["median_s"]), us(e["median_s"]), fmt_ratio(r)])
+    if not rows:
+        return []
+    targets.append(["Issue 20: dynamics service round trips ≤ 1.3× a same-size echo (worst case)", f"{worst:.3g}×",
+                    verdict(worst <= 1.3, "" if worst <= 1.3 else f"over by {worst / 1.3:.2g}×")])
+    return ["", "### Dynamics services against a same-size echo", "",
+            "One free body of the scene (6 coordinates), random states with |θ| ≤ 1; "
+            "`SceneQueries::inverseDynamics` / `forwardDynamics`, the node's code path.",
+            "", md_table(["call", "payload", "service", "echo", "÷ echo"], rows)]
 
 
 def section_scene(scene):
