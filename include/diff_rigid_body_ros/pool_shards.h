@@ -107,6 +107,8 @@ std::size_t configurationCount(const typename Service::Request& request, const S
 
 /// K configurations cut into weights.size() contiguous counts proportional to `weights` (e.g.
 /// measured configurations per second): the largest-remainder rounding, so the counts sum to K.
+/// When K >= weights.size(), every instance gets at least one configuration, taken from the
+/// largest count: an instance measured slow once (a cold start) is measured again, not starved.
 inline std::vector<std::size_t> apportion(std::size_t K, std::vector<double> weights)
 {
   double total = 0.0;
@@ -127,6 +129,10 @@ inline std::vector<std::size_t> apportion(std::size_t K, std::vector<double> wei
   std::stable_sort(remainders.begin(), remainders.end());
   for (std::size_t r = 0; given < K && r < remainders.size(); ++r, ++given)
     ++counts[remainders[r].second];
+  if (K >= counts.size())
+    for (std::size_t& count : counts)
+      if (count == 0)
+        --*std::max_element(counts.begin(), counts.end()), count = 1;
   return counts;
 }
 

@@ -54,7 +54,9 @@ def configuration_count(name, message, dofs):
 def apportion(K, weights):
     """K configurations cut into len(weights) contiguous counts proportional to ``weights``
     (e.g. measured configurations per second): the largest-remainder rounding of
-    K w_i / sum(w), so the counts sum to K."""
+    K w_i / sum(w), so the counts sum to K. When K >= len(weights), every instance gets at least
+    one configuration, taken from the largest count: an instance measured slow once (a cold start)
+    is measured again, not starved."""
     weights = np.maximum(np.asarray(weights, dtype=np.float64), 0.0)
     if not np.isfinite(weights).all() or weights.sum() <= 0.0:
         weights = np.ones(len(weights))
@@ -62,6 +64,10 @@ def apportion(K, weights):
     counts = np.floor(exact).astype(np.int64)
     remainder_order = np.argsort(-(exact - counts), kind='stable')
     counts[remainder_order[:K - int(counts.sum())]] += 1
+    if K >= len(counts):
+        for i in np.flatnonzero(counts == 0):
+            counts[np.argmax(counts)] -= 1
+            counts[i] = 1
     return [int(count) for count in counts]
 
 

@@ -117,16 +117,19 @@ def without_status_bar(image):
     return image[:-STATUS_BAR_ROWS]
 
 
-def wait_for_frame(directory, name, ready, timeout=90.0, period=1.0, stable_frames=2):
+def wait_for_frame(directory, name, ready, timeout=90.0, period=1.0, stable_frames=2, rviz=None):
     """Screenshots every ``period`` s until ``ready(image)`` holds for
     ``stable_frames`` identical frames in a row; returns (path, image), the
     image :func:`without_status_bar`. Raises RuntimeError (naming the last
-    counts) after ``timeout`` s."""
+    counts) after ``timeout`` s. ``rviz`` (an :class:`Rviz`) is started again
+    if it died meanwhile."""
     deadline = time.time() + timeout
     previous = None
     same = 0
     path = os.path.join(directory, name)
     while True:
+        if rviz is not None:
+            rviz.restart_if_dead()
         grab(path)
         image = without_status_bar(read_rgb(path))
         if ready(image):
@@ -154,15 +157,38 @@ def software_gl_environment():
     return env
 
 
-def start_rviz(config=None, log=None):
-    """rviz on $DISPLAY with ``config`` (default: rviz/demo.rviz), in its own process group."""
-    return subprocess.Popen(['rviz', '-d', config or demo_rviz_config(), '__name:=rviz_capture'],
-                            env=software_gl_environment(), stdout=log or subprocess.DEVNULL, stderr=subprocess.STDOUT,
-                            start_new_session=True)
+class Rviz(object):
+    """rviz on $DISPLAY in its own process group, started again by :meth:`restart_if_dead` when it
+    has died: rviz 1.14 with software OpenGL now and then aborts while it starts ("free(): invalid
+    next size"), before it shows anything; a second start is the fix a user would apply."""
+
+    def __init__(self, argv, log=None, starts=3):
+        self.argv, self.log, self.starts_left = argv, log, starts
+        self.process = None
+        self.restart_if_dead()
+
+    def restart_if_dead(self):
+        if self.process is not None and self.process.poll() is None:
+            return
+        if self.starts_left == 0:
+            raise RuntimeError('rviz exited with %s after every start (%s)' % (self.process.returncode, self.argv))
+        if self.process is not None and self.log:
+            self.log.write('\n[rviz_capture] rviz exited with %s; starting it again\n' % self.process.returncode)
+            self.log.flush()
+        self.starts_left -= 1
+        self.process = subprocess.Popen(self.argv, env=software_gl_environment(), stdout=self.log or subprocess.DEVNULL,
+                                        stderr=subprocess.STDOUT, start_new_session=True)
+
+
+def start_rviz(config=None, log=None, fixed_frame=None):
+    """:class:`Rviz` with ``config`` (default: rviz/demo.rviz), in ``fixed_frame`` (default: the config's)."""
+    frame = ['-f', fixed_frame] if fixed_frame else []
+    return Rviz(['rviz', '-d', config or demo_rviz_config()] + frame + ['__name:=rviz_capture'], log)
 
 
 def stop(process, timeout=15.0):
-    """SIGINT to the process group, then SIGKILL."""
+    """SIGINT to the process group (of a Popen or an :class:`Rviz`), then SIGKILL."""
+    process = getattr(process, 'process', process)
     if process is None or process.poll() is not None:
         return
     try:

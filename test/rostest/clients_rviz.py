@@ -77,7 +77,8 @@ class RvizVisualCheck(unittest.TestCase):
         rospy.loginfo('%s: %s, %.3f of the knot marker pixels on its mesh', name, counts, fraction)
 
     def test_rendered_scene_follows_set_state(self):
-        path_a, a = rc.wait_for_frame(self.directory, 'clients_rviz_initial.png', rc.scene_visible, timeout=120.0)
+        path_a, a = rc.wait_for_frame(self.directory, 'clients_rviz_initial.png', rc.scene_visible, timeout=120.0,
+                                         rviz=self.rviz)
         self.assert_scene_visible(a, path_a)
         knot_a = knot_pixels(a)
 
@@ -87,7 +88,7 @@ class RvizVisualCheck(unittest.TestCase):
             shift = np.linalg.norm(rc.centroid(knot_pixels(image)) - rc.centroid(knot_a))
             return rc.scene_visible(image) and shift >= MIN_KNOT_SHIFT
 
-        path_b, b = rc.wait_for_frame(self.directory, 'clients_rviz_moved.png', knot_moved, timeout=60.0)
+        path_b, b = rc.wait_for_frame(self.directory, 'clients_rviz_moved.png', knot_moved, timeout=60.0, rviz=self.rviz)
         self.assert_scene_visible(b, path_b)
         knot_b = knot_pixels(b)
 

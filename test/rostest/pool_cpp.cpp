@@ -149,6 +149,8 @@ TEST(RigidBodyPool, ApportionFollowsThroughput)
   EXPECT_EQ(drb::pool::apportion(8, { 3.0, 1.0 }), (std::vector<std::size_t>{ 6, 2 }));
   EXPECT_EQ(drb::pool::apportion(10, { 1.0, 1.0, 1.0 }), (std::vector<std::size_t>{ 4, 3, 3 }));
   EXPECT_EQ(drb::pool::apportion(5, { 0.0, 0.0 }), (std::vector<std::size_t>{ 3, 2 }));
+  EXPECT_EQ(drb::pool::apportion(400, { 1000.0, 1.0 }), (std::vector<std::size_t>{ 399, 1 }));  // none starved
+  EXPECT_EQ(drb::pool::apportion(1, { 1.0, 1.0 }), (std::vector<std::size_t>{ 1, 0 }));
 }
 
 TEST(RigidBodyPool, RefusesAnInstanceServingAnotherScene)

@@ -35,7 +35,6 @@ The marker-point check fails in both controls too.
 import os
 import re
 import shutil
-import subprocess
 import sys
 import tempfile
 import unittest
@@ -76,13 +75,6 @@ def background_colour(config):
     if match is None:
         raise ValueError('%s names no Background Color' % config)
     return np.array([int(v) for v in match.groups()])
-
-
-def start_rviz(config, fixed_frame, log):
-    """rviz on $DISPLAY with ``config`` in ``fixed_frame``, in its own process group (see rc.stop)."""
-    return subprocess.Popen(['rviz', '-d', config, '-f', fixed_frame, '__name:=rviz_capture'],
-                            env=rc.software_gl_environment(), stdout=log, stderr=subprocess.STDOUT,
-                            start_new_session=True)
 
 
 def wait_until(condition, timeout):
@@ -159,7 +151,7 @@ class PandaInRviz(unittest.TestCase):
         rospy.Subscriber(markers_node + '/markers', MarkerArray, cls.on_markers, queue_size=1)
         wait_until(lambda: cls.marker_error() == 0.0, WAIT)
         cls.log = open(os.path.join(cls.directory, 'robot_panda_rviz_rviz.log'), 'w')
-        cls.rviz = start_rviz(cls.config, cls.fixed_frame, cls.log)
+        cls.rviz = rc.start_rviz(cls.config, cls.log, cls.fixed_frame)
 
     @classmethod
     def tearDownClass(cls):
@@ -226,7 +218,8 @@ class PandaInRviz(unittest.TestCase):
 
     def take_screenshot(self):
         try:
-            return rc.wait_for_frame(self.directory, SCREENSHOT, lambda im: self.masks(im).visible(), timeout=180.0)
+            return rc.wait_for_frame(self.directory, SCREENSHOT, lambda im: self.masks(im).visible(), timeout=180.0,
+                                     rviz=self.rviz)
         except RuntimeError:
             path = os.path.join(self.directory, SCREENSHOT)
             counts = self.masks(rc.without_status_bar(rc.read_rgb(path))).counts()

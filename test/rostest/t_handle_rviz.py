@@ -274,9 +274,7 @@ class THandleFlipInRviz(unittest.TestCase):
             f.write(RVIZ_CONFIG % {'topic': rospy.resolve_name('~strobe'),
                                    'background': '; '.join(str(v) for v in BACKGROUND)})
         cls.log = open(os.path.join(cls.directory, 't_handle_rviz_rviz.log'), 'w')
-        cls.rviz = subprocess.Popen(['rviz', '-d', cls.config, '-f', bodies.fixed_frame, '__name:=rviz_capture'],
-                                    env=rc.software_gl_environment(), stdout=cls.log, stderr=subprocess.STDOUT,
-                                    start_new_session=True)
+        cls.rviz = rc.start_rviz(cls.config, cls.log, bodies.fixed_frame)
 
     @classmethod
     def tearDownClass(cls):
@@ -296,7 +294,7 @@ class THandleFlipInRviz(unittest.TestCase):
     def test_the_grip_turns_over_in_the_picture(self):
         self.assertTrue(0.3 < self.flip < 0.9, 'the toss flips at %s s' % self.flip)
         try:
-            path, image = rc.wait_for_frame(self.directory, SCREENSHOT, self.visible, timeout=WAIT)
+            path, image = rc.wait_for_frame(self.directory, SCREENSHOT, self.visible, timeout=WAIT, rviz=self.rviz)
         except RuntimeError:
             path = os.path.join(self.directory, SCREENSHOT)
             self.fail('rviz did not show the strobe markers and the grip mesh within %g s; pixels of the last frame '
