@@ -212,23 +212,32 @@ def section_service(service, targets):
 
 
 def section_dynamics_services(t, us, targets):
-    """~inverse_dynamics and ~forward_dynamics of one free body against a same-size echo."""
-    rows, worst = [], 0.0
-    for name, label in (("inverse_dynamics/K1", "inverse_dynamics, K = 1"),
-                        ("forward_dynamics/K1", "forward_dynamics, K = 1"),
-                        ("inverse_dynamics/K1000", "inverse_dynamics, K = 1000, derivatives"),
-                        ("forward_dynamics/K1000", "forward_dynamics, K = 1000, derivatives")):
-        x, e = t.get(name), t.get("echo_for_" + name)
-        if not x or not e:
-            continue
-        r = x["median_s"] / e["median_s"]
-        worst = max(worst, r)
-        rows.append([label, f"{x['request_bytes'] / 1e3:.3g} kB up, {x['response_bytes'] / 1e3:.3g} kB down",
-                     us(x["median_s"]), us(e["median_s"]), fmt_ratio(r)])
+    """~inverse_dynamics and ~forward_dynamics of one free body against a same-size echo: K = 1 (the
+    service's own cost) and K = 1000 with derivatives (the node's computation on top)."""
+    rows, worst = [], {1: 0.0, 1000: 0.0}
+    compute = {}
+    for service in ("inverse_dynamics", "forward_dynamics"):
+        for K in (1, 1000):
+            name = f"{service}/K{K}"
+            x, e = t.get(name), t.get("echo_for_" + name)
+            if not x or not e:
+                continue
+            r = x["median_s"] / e["median_s"]
+            worst[K] = max(worst[K], r)
+            if K > 1:
+                compute[service] = (x["median_s"] - e["median_s"]) / K
+            rows.append([f"{service}, K = {K}" + (", derivatives" if K > 1 else ""),
+                         f"{x['request_bytes'] / 1e3:.3g} kB up, {x['response_bytes'] / 1e3:.3g} kB down",
+                         us(x["median_s"]), us(e["median_s"]), fmt_ratio(r)])
     if not rows:
         return []
-    targets.append(["Issue 20: dynamics service round trips ≤ 1.3× a same-size echo (worst case)", f"{worst:.3g}×",
-                    verdict(worst <= 1.3, "" if worst <= 1.3 else f"over by {worst / 1.3:.2g}×")])
+    targets.append(["Issue 20: dynamics service round trips ≤ 1.3× a same-size echo, K = 1", f"{worst[1]:.3g}×",
+                    verdict(worst[1] <= 1.3, "" if worst[1] <= 1.3 else f"over by {worst[1] / 1.3:.2g}×")])
+    per = ", ".join(f"{s.split('_')[0]} {c * 1e6:.2g} µs" for s, c in compute.items())
+    targets.append(["Issue 20: dynamics service round trips ≤ 1.3× a same-size echo, K = 1000 with derivatives",
+                    f"{worst[1000]:.3g}×", verdict(worst[1000] <= 1.3, "" if worst[1000] <= 1.3 else
+                                                   f"the node's computation per configuration ({per}) "
+                                                   "is more than the echo's copy")])
     return ["", "### Dynamics services against a same-size echo", "",
             "One free body of the scene (6 coordinates), random states with |θ| ≤ 1; "
             "`SceneQueries::inverseDynamics` / `forwardDynamics`, the node's code path.",
