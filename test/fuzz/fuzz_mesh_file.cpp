@@ -14,7 +14,6 @@
 // vertices, at least one triangle, and triangle indices in range with three
 // distinct corners. Anything else (a crash or sanitizer report in our code or
 // assimp's, another exception, a hang past -timeout) is a finding.
-#include <unistd.h>
 
 #include <cstdint>
 #include <cstdio>
@@ -63,8 +62,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 {
   if (size < 2)
     return 0;
-  const std::string path =
-      "/tmp/drb_fuzz_mesh_" + std::to_string(::getpid()) + kExtensions[data[0] % 3];
+  // In the working folder, which scripts/fuzz makes per run: the same path in every run.
+  const std::string path = std::string("drb_fuzz_mesh") + kExtensions[data[0] % 3];
   {
     std::FILE* file = std::fopen(path.c_str(), "wb");
     if (!file)

@@ -16,6 +16,7 @@
 // (a crash, a sanitizer report, another exception, a non-finite answer) is
 // a finding.
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <set>
 #include <string>
@@ -31,8 +32,11 @@ namespace
 {
 namespace drb = diff_rigid_body;
 
-const std::string kTestDir = DRB_TEST_DATA_DIR;
-const std::string kMeshDir = kTestDir + "/meshes";
+// The package's folder: $DRB_FUZZ_PACKAGE_DIR (scripts/fuzz: a link to the checkout with a name
+// of fixed length, so that runs from any checkout lay out memory alike), else the checkout.
+const std::string kPackageDir = std::getenv("DRB_FUZZ_PACKAGE_DIR") ? std::getenv("DRB_FUZZ_PACKAGE_DIR") :
+                                                                      std::string(DRB_TEST_DATA_DIR) + "/..";
+const std::string kMeshDir = kPackageDir + "/test/meshes";
 const std::set<std::string> kFixtures = { "box_2x1x0.5.stl",   "tetrahedron.obj",      "bad_degenerate.obj",
                                           "bad_empty.stl",     "bad_garbage.stl",      "bad_huge.obj",
                                           "bad_nan_vertex.obj", "bad_no_triangles.obj", "bad_open_surface.obj" };
@@ -132,7 +136,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   drb::SceneOptions options;
   options.base_directory = kMeshDir;
   options.find_package = [](const std::string& package) {
-    return package == "diff_rigid_body" ? kTestDir + "/.." : std::string();
+    return package == "diff_rigid_body" ? kPackageDir : std::string();
   };
   if (size % 2 == 1)
     options.density = size % 4 == 1 ? 1000.0 : 1e-3;  // [kg/m^3]
