@@ -230,17 +230,7 @@ int runServices(const std::string& out_path, double budget)
     std::uniform_real_distribution<double> u(-3.0, 3.0);
     for (int i = 0; i < 6000; ++i)
       batch.request.q.push_back(u(rng));
-    diff_rigid_body::Echo echo;
-    echo.request.data.assign(6000, 0.5);
-    echo.request.response_size = 37000;
-    auto [t, e] = timePair("get_mass_matrix_K1000", caller(mass_client, batch), "echo_for_get_mass_matrix_K1000",
-                           caller(echo_client, echo), budget);
-    t.request_bytes = 6000 * 8;
-    t.response_bytes = 37000 * 8;
-    timings.push_back(t);
-    e.request_bytes = t.request_bytes;
-    e.response_bytes = t.response_bytes;
-    timings.push_back(e);
+    timeAgainstEcho("get_mass_matrix_K1000", caller(mass_client, batch), 6000, 37000, echo_client, budget, timings);
   }
 
   const std::vector<double> q = { 0.3, -1.2, 2.5, 0.5, -0.25, 1.5 };
@@ -321,17 +311,7 @@ int runServices(const std::string& out_path, double budget)
     std::normal_distribution<double> g(0.0, 1.0);
     for (double& x : bp.request.gradients)
       x = g(rng);
-    diff_rigid_body::Echo be;
-    be.request.data = bp.request.gradients;
-    be.request.response_size = 6;
-    auto [tb, tbe] = timePair("backprop" + suffix, caller(bp_client, bp), "echo_for_backprop" + suffix,
-                              caller(echo_client, be), body_budget);
-    tb.request_bytes = 3 * 8 * n;
-    tb.response_bytes = 6 * 8;
-    timings.push_back(tb);
-    tbe.request_bytes = tb.request_bytes;
-    tbe.response_bytes = tb.response_bytes;
-    timings.push_back(tbe);
+    timeAgainstEcho("backprop" + suffix, caller(bp_client, bp), 3 * n, 6, echo_client, body_budget, timings);
     std::fprintf(stderr, "drb_bench_service: %s (%zu vertices) done\n", body.c_str(), n);
   }
   timeDynamics(nh, ns, bodies.response.names.front(), echo_client, budget, timings);
