@@ -44,9 +44,16 @@
 #include <diff_rigid_body/InverseDynamics.h>
 #include <diff_rigid_body/Ping.h>
 
+#include "service_timing.h"
+
 namespace
 {
-using Clock = std::chrono::steady_clock;
+using drb_bench::caller;
+using drb_bench::Clock;
+using drb_bench::persistentClient;
+using drb_bench::timeAgainstEcho;
+using drb_bench::timePair;
+using drb_bench::Timing;
 
 /// roscpp's ServiceClient takes no TransportHints: set TCP_NODELAY on every
 /// TCP socket of this (client-only) process instead. Returns how many.
@@ -78,78 +85,109 @@ int setNoDelayOnAllSockets()
   return count;
 }
 
-struct Timing
+/// ~get_mass_matrix of one body against ~ping, then K = 1000 configurations against the same-size echo.
+void timeMassMatrix(ros::ServiceClient& mass_client, diff_rigid_body::GetMassMatrix& mass,
+                    ros::ServiceClient& ping_client, ros::ServiceClient& echo_client, double budget,
+                    std::vector<Timing>& timings)
 {
-  std::string name;
-  std::size_t calls = 0;
-  double median = 0, p25 = 0, p75 = 0, min = 0;  // seconds per call
-  std::size_t request_bytes = 0, response_bytes = 0;  // payload (array data)
-  std::string extra;  // additional JSON fields
+  diff_rigid_body::Ping ping;
+  auto [m, p] = timePair("get_mass_matrix", caller(mass_client, mass), "ping", caller(ping_client, ping), budget);
+  m.response_bytes = 36 * 8;
+  timings.push_back(p);
+  timings.push_back(m);
+
+  diff_rigid_body::GetMassMatrix batch;
+  batch.request.bodies = mass.request.bodies;
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> u(-3.0, 3.0);
+  for (int i = 0; i < 6000; ++i)
+    batch.request.q.push_back(u(rng));
+  timeAgainstEcho("get_mass_matrix_K1000", caller(mass_client, batch), 6000, 37000, echo_client, budget, timings);
+}
+
+/// A reduced transport of ~get_vertex_jacobians_compact.
+struct CompactVariant
+{
+  const char* name;
+  bool positions_only, single_precision;
+  std::size_t bytes_per_vertex;
 };
 
-/// Times two calls alternately (A, B, A, B, ...), so that both see the same
-/// machine load: the ratio A / B is what the report uses.
-std::pair<Timing, Timing> timePair(const std::string& name_a, const std::function<bool()>& a,
-                                   const std::string& name_b, const std::function<bool()>& b, double budget)
+/// JSON fields of a reduced transport's error against the full answer:
+/// max |difference| / max |full value|, for the positions and the rotation block.
+std::string compactErrors(const CompactVariant& v, const diff_rigid_body::GetVertexJacobians::Response& full,
+                          const diff_rigid_body::GetVertexJacobiansCompact::Response& compact, std::size_t n)
 {
-  for (int i = 0; i < 3; ++i)
-    if (!a() || !b())
-      throw std::runtime_error(name_a + " / " + name_b + ": call failed");
-  std::vector<double> runs_a, runs_b;
-  const auto start = Clock::now();
-  while (runs_a.size() < 5 ||
-         (std::chrono::duration<double>(Clock::now() - start).count() < 2 * budget && runs_a.size() < 20000))
+  double pos_err = 0, pos_scale = 0, jac_err = 0, jac_scale = 0;
+  for (std::size_t i = 0; i < 3 * n; ++i)
   {
-    for (int which = 0; which < 2; ++which)
-    {
-      const auto t0 = Clock::now();
-      if (!(which == 0 ? a() : b()))
-        throw std::runtime_error((which == 0 ? name_a : name_b) + ": call failed");
-      (which == 0 ? runs_a : runs_b).push_back(std::chrono::duration<double>(Clock::now() - t0).count());
-    }
+    const double got = v.single_precision ? compact.positions_f32[i] : compact.positions[i];
+    pos_err = std::max(pos_err, std::abs(got - full.positions[i]));
+    pos_scale = std::max(pos_scale, std::abs(full.positions[i]));
   }
-  auto summarise = [](const std::string& name, std::vector<double>& runs) {
-    Timing t;
-    t.name = name;
-    std::sort(runs.begin(), runs.end());
-    t.calls = runs.size();
-    t.min = runs.front();
-    t.median = runs[runs.size() / 2];
-    t.p25 = runs[runs.size() / 4];
-    t.p75 = runs[(3 * runs.size()) / 4];
-    return t;
-  };
-  return { summarise(name_a, runs_a), summarise(name_b, runs_b) };
+  if (!v.positions_only)
+    for (std::size_t i = 0; i < n; ++i)
+      for (int r = 0; r < 3; ++r)
+        for (int k = 0; k < 3; ++k)
+        {
+          const double value = full.jacobians[18 * i + 6 * r + k];
+          const double got = v.single_precision ? compact.rotation_jacobians_f32[9 * i + 3 * r + k]
+                                                : compact.rotation_jacobians[9 * i + 3 * r + k];
+          jac_err = std::max(jac_err, std::abs(got - value));
+          jac_scale = std::max(jac_scale, std::abs(value));
+        }
+  char extra[160];
+  std::snprintf(extra, sizeof(extra), "\"position_rel_error\": %.6g, \"jacobian_rel_error\": %.6g",
+                pos_scale > 0 ? pos_err / pos_scale : 0.0, jac_scale > 0 ? jac_err / jac_scale : 0.0);
+  return extra;
 }
 
-template <typename Service>
-ros::ServiceClient persistentClient(ros::NodeHandle& nh, const std::string& name)
+/// ~get_vertex_jacobians of one body with n vertices, then each reduced transport, each
+/// against ~echo of its response's size.
+void timeJacobians(ros::ServiceClient& jac_client, ros::ServiceClient& compact_client,
+                   ros::ServiceClient& echo_client, const std::string& body, std::size_t n,
+                   const std::vector<double>& q, double budget, std::vector<Timing>& timings)
 {
-  if (!ros::service::waitForService(name, ros::Duration(60.0)))
-    throw std::runtime_error("service " + name + " did not appear");
-  return nh.serviceClient<Service>(name, /*persistent=*/true);
+  const std::string suffix = "/" + std::to_string(n);
+  diff_rigid_body::GetVertexJacobians jac;
+  jac.request.body = body;
+  jac.request.q = q;
+  timeAgainstEcho("get_vertex_jacobians" + suffix, caller(jac_client, jac), 0, 21 * n, echo_client, budget,
+                  timings);
+  const CompactVariant variants[] = { { "compact_rotation_block", false, false, 12 * 8 },
+                                      { "compact_rotation_block_f32", false, true, 12 * 4 },
+                                      { "compact_positions_only", true, false, 3 * 8 } };
+  for (const CompactVariant& v : variants)
+  {
+    diff_rigid_body::GetVertexJacobiansCompact compact;
+    compact.request.body = body;
+    compact.request.q = q;
+    compact.request.positions_only = v.positions_only;
+    compact.request.single_precision = v.single_precision;
+    diff_rigid_body::Echo echo;
+    echo.request.response_size = static_cast<std::uint32_t>((v.bytes_per_vertex * n + 7) / 8);
+    auto [c, e] = timePair(std::string(v.name) + suffix, caller(compact_client, compact),
+                           std::string("echo_for_") + v.name + suffix, caller(echo_client, echo), budget);
+    c.response_bytes = e.response_bytes = v.bytes_per_vertex * n;
+    c.extra = compactErrors(v, jac.response, compact.response, n);
+    timings.push_back(c);
+    timings.push_back(e);
+  }
 }
 
-template <typename Service>
-std::function<bool()> caller(ros::ServiceClient& client, Service& srv)
+/// ~backprop of one body with n vertices (normal random gradients) against the same-size echo.
+void timeBackprop(ros::ServiceClient& bp_client, ros::ServiceClient& echo_client, const std::string& body,
+                  std::size_t n, const std::vector<double>& q, double budget, std::vector<Timing>& timings)
 {
-  return [&client, &srv] { return client.call(srv) && srv.response.success; };
-}
-
-/// Times `call` alternately with ~echo carrying `request_values` doubles up and `response_values`
-/// down (the call's array payload), and appends both timings.
-void timeAgainstEcho(const std::string& name, const std::function<bool()>& call, std::size_t request_values,
-                     std::size_t response_values, ros::ServiceClient& echo_client, double budget,
-                     std::vector<Timing>& timings)
-{
-  diff_rigid_body::Echo echo;
-  echo.request.data.assign(request_values, 0.5);
-  echo.request.response_size = static_cast<std::uint32_t>(response_values);
-  auto [t, e] = timePair(name, call, "echo_for_" + name, caller(echo_client, echo), budget);
-  t.request_bytes = e.request_bytes = 8 * request_values;
-  t.response_bytes = e.response_bytes = 8 * response_values;
-  timings.push_back(t);
-  timings.push_back(e);
+  diff_rigid_body::Backprop bp;
+  bp.request.body = body;
+  bp.request.q = q;
+  bp.request.gradients.resize(3 * n);
+  std::mt19937_64 rng(n);
+  std::normal_distribution<double> g(0.0, 1.0);
+  for (double& x : bp.request.gradients)
+    x = g(rng);
+  timeAgainstEcho("backprop/" + std::to_string(n), caller(bp_client, bp), 3 * n, 6, echo_client, budget, timings);
 }
 
 /// ~inverse_dynamics and ~forward_dynamics of one free body (6 coordinates): K = 1 without
@@ -209,139 +247,34 @@ int runServices(const std::string& out_path, double budget)
   if (!bodies_client.call(bodies) || !bodies.response.success)
     throw std::runtime_error("get_bodies failed");
 
-  std::vector<Timing> timings;
   // Everything with roscpp's default sockets first (what a roscpp client
   // gets), then ~ping and ~get_mass_matrix again with TCP_NODELAY.
-  diff_rigid_body::Ping ping;
+  std::vector<Timing> timings;
   diff_rigid_body::GetMassMatrix mass;
   mass.request.bodies = { bodies.response.names.front() };
   mass.request.q = { 0.3, -0.2, 0.1, 1.0, 2.0, 3.0 };
-  {
-    auto [m, p] = timePair("get_mass_matrix", caller(mass_client, mass), "ping", caller(ping_client, ping), budget);
-    m.response_bytes = 36 * 8;
-    timings.push_back(p);
-    timings.push_back(m);
-  }
-  {
-    // K = 1000 configurations of one body, against the same-size echo.
-    diff_rigid_body::GetMassMatrix batch;
-    batch.request.bodies = mass.request.bodies;
-    std::mt19937_64 rng(4);
-    std::uniform_real_distribution<double> u(-3.0, 3.0);
-    for (int i = 0; i < 6000; ++i)
-      batch.request.q.push_back(u(rng));
-    timeAgainstEcho("get_mass_matrix_K1000", caller(mass_client, batch), 6000, 37000, echo_client, budget, timings);
-  }
-
+  timeMassMatrix(mass_client, mass, ping_client, echo_client, budget, timings);
   const std::vector<double> q = { 0.3, -1.2, 2.5, 0.5, -0.25, 1.5 };
   for (std::size_t b = 0; b < bodies.response.names.size(); ++b)
   {
     const std::string& body = bodies.response.names[b];
     const std::size_t n = bodies.response.vertex_counts[b];
-    const std::string suffix = "/" + std::to_string(n);
     const double body_budget = n >= 100000 ? std::max(budget, 1.0) : budget;
-
-    diff_rigid_body::GetVertexJacobians jac;
-    jac.request.body = body;
-    jac.request.q = q;
-    diff_rigid_body::Echo echo;
-    echo.request.response_size = static_cast<std::uint32_t>(21 * n);
-    auto [t, e] = timePair("get_vertex_jacobians" + suffix, caller(jac_client, jac),
-                           "echo_for_get_vertex_jacobians" + suffix, caller(echo_client, echo), body_budget);
-    t.response_bytes = 21 * 8 * n;
-    timings.push_back(t);
-    e.response_bytes = t.response_bytes;
-    timings.push_back(e);
-
-    // Reduced transports, each with its same-size echo and its error
-    // against the full answer (max |difference| / max |full value|, per field).
-    struct Variant
-    {
-      const char* name;
-      bool positions_only, single_precision;
-      std::size_t bytes_per_vertex;
-    };
-    const Variant variants[] = { { "compact_rotation_block", false, false, 12 * 8 },
-                                 { "compact_rotation_block_f32", false, true, 12 * 4 },
-                                 { "compact_positions_only", true, false, 3 * 8 } };
-    for (const Variant& v : variants)
-    {
-      diff_rigid_body::GetVertexJacobiansCompact compact;
-      compact.request.body = body;
-      compact.request.q = q;
-      compact.request.positions_only = v.positions_only;
-      compact.request.single_precision = v.single_precision;
-      diff_rigid_body::Echo ce;
-      ce.request.response_size = static_cast<std::uint32_t>((v.bytes_per_vertex * n + 7) / 8);
-      auto [c, cet] = timePair(std::string(v.name) + suffix, caller(compact_client, compact),
-                               std::string("echo_for_") + v.name + suffix, caller(echo_client, ce), body_budget);
-      c.response_bytes = v.bytes_per_vertex * n;
-      double pos_err = 0, pos_scale = 0, jac_err = 0, jac_scale = 0;
-      for (std::size_t i = 0; i < 3 * n; ++i)
-      {
-        const double got = v.single_precision ? compact.response.positions_f32[i] : compact.response.positions[i];
-        pos_err = std::max(pos_err, std::abs(got - jac.response.positions[i]));
-        pos_scale = std::max(pos_scale, std::abs(jac.response.positions[i]));
-      }
-      if (!v.positions_only)
-        for (std::size_t i = 0; i < n; ++i)
-          for (int r = 0; r < 3; ++r)
-            for (int k = 0; k < 3; ++k)
-            {
-              const double full = jac.response.jacobians[18 * i + 6 * r + k];
-              const double got = v.single_precision ? compact.response.rotation_jacobians_f32[9 * i + 3 * r + k]
-                                                    : compact.response.rotation_jacobians[9 * i + 3 * r + k];
-              jac_err = std::max(jac_err, std::abs(got - full));
-              jac_scale = std::max(jac_scale, std::abs(full));
-            }
-      char extra[160];
-      std::snprintf(extra, sizeof(extra), "\"position_rel_error\": %.6g, \"jacobian_rel_error\": %.6g",
-                    pos_scale > 0 ? pos_err / pos_scale : 0.0, jac_scale > 0 ? jac_err / jac_scale : 0.0);
-      c.extra = extra;
-      timings.push_back(c);
-      cet.response_bytes = c.response_bytes;
-      timings.push_back(cet);
-    }
-
-    diff_rigid_body::Backprop bp;
-    bp.request.body = body;
-    bp.request.q = q;
-    bp.request.gradients.resize(3 * n);
-    std::mt19937_64 rng(n);
-    std::normal_distribution<double> g(0.0, 1.0);
-    for (double& x : bp.request.gradients)
-      x = g(rng);
-    timeAgainstEcho("backprop" + suffix, caller(bp_client, bp), 3 * n, 6, echo_client, body_budget, timings);
+    timeJacobians(jac_client, compact_client, echo_client, body, n, q, body_budget, timings);
+    timeBackprop(bp_client, echo_client, body, n, q, body_budget, timings);
     std::fprintf(stderr, "drb_bench_service: %s (%zu vertices) done\n", body.c_str(), n);
   }
   timeDynamics(nh, ns, bodies.response.names.front(), echo_client, budget, timings);
 
-  // TCP_NODELAY on every connection of this client, then the small calls again.
   const int sockets = setNoDelayOnAllSockets();
   std::fprintf(stderr, "drb_bench_service: TCP_NODELAY on %d sockets\n", sockets);
-  {
-    auto [m, p] = timePair("get_mass_matrix_nodelay", caller(mass_client, mass), "ping_nodelay",
-                           caller(ping_client, ping), budget);
-    m.response_bytes = 36 * 8;
-    timings.push_back(p);
-    timings.push_back(m);
-  }
-
-  std::FILE* out = std::fopen(out_path.c_str(), "w");
-  if (!out)
-    throw std::runtime_error("cannot write " + out_path);
-  std::fprintf(out, "{\"nodelay_sockets\": %d, \"timings\": [\n", sockets);
-  for (std::size_t i = 0; i < timings.size(); ++i)
-  {
-    const Timing& t = timings[i];
-    std::fprintf(out,
-                 "  {\"name\": \"%s\", \"calls\": %zu, \"median_s\": %.6g, \"p25_s\": %.6g, \"p75_s\": %.6g, "
-                 "\"min_s\": %.6g, \"request_bytes\": %zu, \"response_bytes\": %zu%s%s}%s\n",
-                 t.name.c_str(), t.calls, t.median, t.p25, t.p75, t.min, t.request_bytes, t.response_bytes,
-                 t.extra.empty() ? "" : ", ", t.extra.c_str(), i + 1 < timings.size() ? "," : "");
-  }
-  std::fprintf(out, "]}\n");
-  std::fclose(out);
+  diff_rigid_body::Ping ping;
+  auto [m, p] = timePair("get_mass_matrix_nodelay", caller(mass_client, mass), "ping_nodelay",
+                         caller(ping_client, ping), budget);
+  m.response_bytes = 36 * 8;
+  timings.push_back(p);
+  timings.push_back(m);
+  drb_bench::writeTimings(out_path, sockets, timings);
   return 0;
 }
 
