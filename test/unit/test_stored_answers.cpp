@@ -13,8 +13,12 @@
 // backprop for the subset and for all vertices.
 //
 // Free bodies (a floating joint and no joints below it) must answer bit for
-// bit; articulated bodies within 8 DBL_EPSILON max(1, max|stored|) per
-// entry, or one float ulp for float32 (the restructuring may reorder sums).
+// bit, except backprop; articulated bodies within 8 DBL_EPSILON
+// max(1, max|stored|) per entry, or one float ulp for float32 (the
+// restructuring may reorder sums). Backprop is always compared within that
+// tolerance: its summation engine (detail/backprop_sums.h) sums in AVX-512,
+// AVX2 or portable lanes as the CPU has them, so the order of its sums,
+// and their last bits, depend on the machine.
 //
 // Regenerating: DRB_WRITE_STORED_ANSWERS=<dir> test_core
 // --gtest_filter='StoredAnswers*' writes <dir>/<file>.txt instead of
@@ -235,10 +239,12 @@ void vertexAnswers(const drb::SceneQueries& queries, const drb::SceneState& stat
 }
 
 /// dL/dx = sum_i J_i^T g_i: subset and all vertices at the K configurations,
-/// and the subset at the current state (q empty; the first K block of g).
+/// and the subset at the current state (q empty; the first K block of g),
+/// within the tolerance on every CPU (see the header comment).
 void backpropAnswers(const drb::SceneQueries& queries, const drb::SceneState& state, const BodyInputs& in,
-                     Match match, AnswerBook& book)
+                     AnswerBook& book)
 {
+  const Match match = Match::Tolerance;
   book.numbers(in.name, "backprop/subset",
                queries.backpropConfigurations(state, in.name, in.subset, in.subset_gradients, in.q), match);
   book.numbers(in.name, "backprop/all",
@@ -318,7 +324,7 @@ void checkScene(const SceneSpec& spec, AnswerBook& book)
                  Match::Exact);
     massAnswers(queries, state, in, matches[i], book);
     vertexAnswers(queries, state, in, matches[i], book);
-    backpropAnswers(queries, state, in, matches[i], book);
+    backpropAnswers(queries, state, in, book);
   }
   sceneMassAnswers(queries, state, bodies, matches, book);
 }
