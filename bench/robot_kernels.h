@@ -112,7 +112,7 @@ VectorX<Scalar> robotForwardDynamics(const RobotModel& robot, const std::vector<
   return xdd;
 }
 
-/// M(x)^-1 from our factorization (tree_factorization.h), column by column.
+/// M(x)^-1 = A^-1 H^-1 A^-T from our factorization of H (forward_dynamics.h).
 template <typename Scalar>
 MatrixX<Scalar> robotInverseMass(const RobotModel& robot, const std::vector<Scalar>& x)
 {
@@ -122,12 +122,12 @@ MatrixX<Scalar> robotInverseMass(const RobotModel& robot, const std::vector<Scal
     const drb::BodyModel& body = robot.bodies[b];
     const Eigen::Index n = static_cast<Eigen::Index>(body.coordinates), o = static_cast<Eigen::Index>(robot.offsets[b]);
     drb::BodyWorkspace<Scalar> ws(body);
-    drb::crba(body, ws, x.data() + o);
-    if (drb::factorMassMatrix(body, ws) >= 0)
+    std::vector<Scalar> xdd(static_cast<std::size_t>(n));
+    if (drb::forwardDynamics(body, ws, x.data() + o, static_cast<const Scalar*>(nullptr),
+                             static_cast<const Scalar*>(nullptr), drb::Vector3<Scalar>::Zero().eval(), xdd.data()) >= 0)
       throw std::runtime_error("inverse mass: M is singular");
-    MatrixX<Scalar> block = MatrixX<Scalar>::Identity(n, n);
-    for (Eigen::Index c = 0; c < n; ++c)
-      drb::solveMassMatrix(body, ws, block.col(c).data());
+    MatrixX<Scalar> block(n, n);
+    drb::inverseMassMatrix(body, ws, block);
     inverse.block(o, o, n, n) = block;
   }
   return inverse;

@@ -24,13 +24,26 @@
 // -COM in that frame. Joint placements below it are folded into the same
 // frame at load.
 //
-// Dofs. Every coordinate enters through one or more dofs, 1-dof motions in a
-// tree (MuJoCo's dof_parentid): one per joint, and six for a free root, in
-// the chain order tx, ty, tz, psi, theta, phi (translations, then
-// R = Rz(psi) Ry(theta) Rx(phi) about the COM). A dof moves its segment and
-// that segment's subtree; its parent is the dof just above it on the path to
-// the root. The algorithms walk these parent arrays, so their work follows
-// the depth of the tree, never segments x coordinates.
+// Dofs and motion coordinates. Every coordinate enters through one or more
+// dofs, 1-dof motions in a tree (MuJoCo's dof_parentid): one per joint, and
+// six for a free root, in the chain order tx, ty, tz, wx, wy, wz
+// (translations of the COM, then rotations about the fixed frame's axes
+// through the COM). A dof moves its segment and that segment's subtree; its
+// parent is the dof just above it on the path to the root. The algorithms
+// walk these parent arrays, so their work follows the depth of the tree,
+// never segments x coordinates.
+//
+// The algorithms run in motion coordinates nu (velocities) rather than x':
+// a dof's velocity is multiplier nu[coordinate], where nu = x' except for a
+// free root's first three, its angular velocity w = T(x_r) x_r' in the fixed
+// frame (free_root_chart.h). The Euler-angle chart enters only at the edge
+// (motion_coordinates.h), so nothing inside divides by cos(theta).
+//
+// A free root's three rotations form one joint block: their axes are fixed
+// in the fixed frame, so moving one does not carry the others (in a chain
+// of 1-dof joints each dof carries every dof below it). Dof::carrier and
+// Dof::block_last say so; for every other dof they are its parent and
+// itself.
 #pragma once
 
 #include <cstdint>
@@ -56,8 +69,14 @@ struct Dof
 {
   int parent = -1;        ///< the dof just above it on the path to the root; -1 for none
   int segment = 0;        ///< the segment it moves, with that segment's subtree
-  int coordinate = 0;     ///< index into x
-  double multiplier = 1;  ///< its velocity is multiplier x'[coordinate] (mimic joints; 1 otherwise)
+  int coordinate = 0;     ///< index into x and into nu
+  double multiplier = 1;  ///< its velocity is multiplier nu[coordinate] (mimic joints; 1 otherwise)
+  /// The dof whose motion carries its axis (-1: the fixed frame): its parent,
+  /// except for a free root's rotations, whose axes go with the COM (tz).
+  int carrier = -1;
+  /// The last dof of its joint block: the dofs in (this, block_last] share
+  /// its segment and are not carried by it. Itself but for a free root's rotations.
+  int block_last = 0;
 };
 
 /// One moving link with the links fixed to it.
@@ -79,7 +98,8 @@ struct Segment
   /// Joint value = multiplier x[coordinate] + offset, the multiplier being
   /// its dof's (mimic joints; offset 0 otherwise) [rad or m].
   double offset = 0.0;
-  /// Its dofs: [first_dof, first_dof + dof_count); 6 for a free root, else 1.
+  /// Its dofs: [first_dof, first_dof + dof_count); 6 for a free root (tx,
+  /// ty, tz, wx, wy, wz), else 1.
   int first_dof = 0;
   int dof_count = 1;
   /// Composite mass properties of its links in the segment frame (COM 0

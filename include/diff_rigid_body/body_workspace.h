@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include "diff_rigid_body/body_model.h"
+#include "diff_rigid_body/free_root_chart.h"
 #include "diff_rigid_body/spatial.h"
 
 namespace diff_rigid_body
@@ -32,6 +33,12 @@ struct BodyWorkspace
     composite.resize(n);
     momentum.resize(dofs);
     M.resize(static_cast<Eigen::Index>(d), static_cast<Eigen::Index>(d));
+    H.resize(static_cast<Eigen::Index>(d), static_cast<Eigen::Index>(d));
+    nu.resize(static_cast<Eigen::Index>(d));
+    nu_dot.resize(static_cast<Eigen::Index>(d));
+    force_nu.resize(static_cast<Eigen::Index>(d));
+    rotation_columns.resize(static_cast<Eigen::Index>(d), 3);
+    chart_columns.resize(static_cast<Eigen::Index>(d), 2);
     carried_rate.resize(dofs);
     body_inertia.resize(n);
     dof_velocity.resize(dofs);
@@ -70,11 +77,19 @@ struct BodyWorkspace
   /// psi after the joints), so that the double path takes them in one
   /// vectorised call.
   std::vector<Scalar> joint_angle, joint_sine, joint_cosine;
+  FreeRootChart<Scalar> chart;  ///< a free root's chart at x (free_root_chart.h)
+
+  // ---- motion_coordinates.h ----
+  VectorX nu, nu_dot;  ///< d: motion coordinates and their rates
+  VectorX force_nu;    ///< d: a generalized force in nu (A^-T tau)
+  MatrixX rotation_columns;  ///< d x 3: H's columns of a free root's w
+  MatrixX chart_columns;     ///< d x 2: scratch of the chart's theta and psi columns
 
   // ---- crba.h ----
   std::vector<Inertia<Scalar>> composite;  ///< per segment: its subtree's inertia about r
   std::vector<Force<Scalar>> momentum;     ///< per dof: composite[its segment] S
-  MatrixX M;                               ///< d x d
+  MatrixX H;                               ///< d x d: the mass matrix in nu
+  MatrixX M;                               ///< d x d: in x, A^T H A
 
   // ---- mass_matrix_derivatives.h ----
   std::vector<Inertia<Scalar>> carried_rate;  ///< per dof: the rate of composite[its segment] under its motion
@@ -94,8 +109,9 @@ struct BodyWorkspace
   std::vector<Matrix6> composite_velocity_rate;
   struct DofTerms
   {
-    Motion<Scalar> u;      ///< S_k x v_k
-    Motion<Scalar> w;      ///< S_k x a_k - u_k x v_k
+    Motion<Scalar> u;      ///< S_k x v_l (l: the last dof of k's block; k itself but in a free root's rotations)
+    Motion<Scalar> ubar;   ///< u_k - v_carrier x S_k (2 u_k when the carrier is the parent)
+    Motion<Scalar> w;      ///< S_k x a_l - u_k x v_l
     Force<Scalar> gamma;   ///< B^c^T S_k
     Force<Scalar> moved;   ///< what moving dof k adds to the subtree force above it (by q or q')
   };
@@ -103,7 +119,7 @@ struct BodyWorkspace
   std::vector<Force<Scalar>> momentum_rate;  ///< per dof: what its velocity adds to the subtree force above it
 
   // ---- forward_dynamics.h ----
-  MatrixX factor;       ///< d x d: M's factorization (tree_factorization.h)
+  MatrixX factor;       ///< d x d: H's factorization (tree_factorization.h)
   MatrixX factor_rows;  ///< d x d: scratch of solveMassMatrixColumns
   VectorX solution;  ///< d
   /// d x d each: d(tau or x'')/dx, d(tau or x'')/dx', M^-1, for the node's answers.

@@ -11,12 +11,15 @@
 // F_b = Ic_seg(b) S_b is formed once and paired with the motions up its
 // path, following the parent array: O(dofs x depth).
 //
-// For a free root (x = q of version 1) the 6 x 6 block is
-// blockdiag(T^T I' T, m I3) when the body is one segment (math.md); a free
-// object takes that closed form (free_body/mass_matrix.h) in massMatrices.
+// The recursion runs in motion coordinates (body_model.h) and gives H, the
+// mass matrix in nu; M(x) = A^T H A (motion_coordinates.h). For a free root
+// (x = q of version 1) the 6 x 6 block of M is blockdiag(T^T I' T, m I3)
+// when the body is one segment (docs/derivation.md); a free object takes
+// that closed form (free_body/mass_matrix.h) in massMatrices.
 #pragma once
 
 #include "diff_rigid_body/kinematics.h"
+#include "diff_rigid_body/motion_coordinates.h"
 
 namespace diff_rigid_body
 {
@@ -43,13 +46,14 @@ void compositeInertias(const BodyModel& model, BodyWorkspace<Scalar>& ws)
 }
 }  // namespace detail
 
-/// M(x) into ws.M (d x d, symmetric) from the kinematics already in ws
-/// (forwardKinematics); also leaves ws.body_inertia, ws.composite and ws.momentum.
+/// H, the mass matrix in motion coordinates, into ws.H (d x d, symmetric)
+/// from the kinematics already in ws (forwardKinematics); also leaves
+/// ws.body_inertia, ws.composite and ws.momentum.
 template <typename Scalar>
 void crbaFromKinematics(const BodyModel& model, BodyWorkspace<Scalar>& ws)
 {
   detail::compositeInertias(model, ws);
-  ws.M.setZero();
+  ws.H.setZero();
   for (std::size_t b = 0; b < model.dofs.size(); ++b)
   {
     const Dof& deeper = model.dofs[b];
@@ -61,19 +65,21 @@ void crbaFromKinematics(const BodyModel& model, BodyWorkspace<Scalar>& ws)
       const Dof& upper = model.dofs[static_cast<std::size_t>(a)];
       const Scalar value = Scalar(upper.multiplier * deeper.multiplier) * spatial::power(ws.S[static_cast<std::size_t>(a)], F);
       const Eigen::Index ca = upper.coordinate;
-      ws.M(ca, cb) += value;
+      ws.H(ca, cb) += value;
       if (a != static_cast<int>(b))
-        ws.M(cb, ca) += value;
+        ws.H(cb, ca) += value;
     }
   }
 }
 
-/// M(x) into ws.M: forward kinematics, then crbaFromKinematics.
+/// M(x) into ws.M (and H into ws.H): forward kinematics, crbaFromKinematics,
+/// then M = A^T H A.
 template <typename Scalar>
 void crba(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Scalar* x)
 {
   forwardKinematics(model, ws, x);
   crbaFromKinematics(model, ws);
+  massMatrixToCoordinates(model, ws);
 }
 
 /// The node's M for K configurations x_k = x + k stride, k < count: matrix k

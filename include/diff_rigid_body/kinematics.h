@@ -17,11 +17,12 @@
 // fixed frame's origin):
 //   revolute dof:   (a, a x (r - pj))     prismatic dof:  (0, a)
 //   free root:      tx, ty, tz: (0, e_x), (0, e_y), (0, e_z);
-//                   psi, theta, phi: (T_2, 0), (T_1, 0), (T_0, 0), with T_k
-//                   the columns of T(phi, theta, psi) (rpy.h): the axes of
-//                   the Z, Y', X'' rotations through t.
-// A point p of segment s then moves with dp/dx_c = sum over the dofs k on
-// its path to the root that x_c drives of multiplier_k (S_k.v + S_k.w x (p - r)).
+//                   wx, wy, wz: (e_x, 0), (e_y, 0), (e_z, 0), rotations
+//                   about the fixed axes through t (motion coordinates,
+//                   body_model.h), with the chart T(phi, theta, psi) in ws.chart.
+// A point p of segment s then moves with dp/dnu_c = sum over the dofs k on
+// its path to the root that nu_c drives of multiplier_k (S_k.v + S_k.w x (p - r)),
+// and dp/dx = (dp/dnu) A (motion_coordinates.h).
 //
 // In double, the sines and cosines of every joint angle and of the free
 // root's angles come from one vectorised call (sinCos, rpy.h).
@@ -34,6 +35,7 @@
 
 #include "diff_rigid_body/body_workspace.h"
 #include "diff_rigid_body/free_body/pose.h"
+#include "diff_rigid_body/free_root_chart.h"
 #include "diff_rigid_body/rpy.h"
 
 namespace diff_rigid_body
@@ -137,7 +139,8 @@ void placeJointSegment(const BodyModel& model, BodyWorkspace<Scalar>& ws, std::s
   }
 }
 
-/// The free root's frame (R(phi, theta, psi), t) and its six unit motions.
+/// The free root's frame (R(phi, theta, psi), t), its chart (ws.chart) and
+/// its six unit motions at r = t: tx, ty, tz: (0, e_k); wx, wy, wz: (e_k, 0).
 template <typename Scalar>
 void placeFreeRoot(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Scalar* x)
 {
@@ -146,13 +149,13 @@ void placeFreeRoot(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Scal
   ws.R[0] = rpyToMatrix(trig);
   ws.p[0] << x[TX], x[TY], x[TZ];
   ws.r = ws.p[0];
-  const Matrix3<Scalar> T = angularVelocityMatrixWorld(trig);
+  ws.chart = FreeRootChart<Scalar>(trig);
   Motion<Scalar>* S = &ws.S[static_cast<std::size_t>(model.segments[0].first_dof)];
-  for (int k = 0; k < 3; ++k)  // tx, ty, tz, then psi, theta, phi
+  for (int k = 0; k < 3; ++k)
   {
     S[k].w.setZero();
     S[k].v = Vector3<Scalar>::Unit(k);
-    S[3 + k].w = T.col(2 - k);
+    S[3 + k].w = Vector3<Scalar>::Unit(k);
     S[3 + k].v.setZero();
   }
 }

@@ -1,23 +1,26 @@
 // dM/dx of a body, analytically: the derivative of the composite-rigid-body
-// recursion (crba.h). Moving dof k carries everything below it: the unit
-// motions, momenta and inertias of its subtree change as
+// recursion (crba.h), in motion coordinates, then through the chart.
+//
+// Moving dof k carries everything it moves but the dofs of its own block
+// after it (body_model.h): the unit motions, momenta and inertias change as
 //   dS/dq_k = S_k x S,   dF/dq_k = S_k x* F,   dIc/dq_k = rate of Ic under S_k
-// (spatial.h), and nothing above it changes. With M(c_a, c_b) built from
-// S_a . Ic_seg(b) S_b for a an ancestor of b (or b), the three cases are
-//   k an ancestor of a, or a:        0 (the pair moves rigidly; S . Y S is
+// (spatial.h), and nothing above it changes. With H(c_a, c_b) built from
+// S_a . Ic_seg(b) S_b for a an ancestor of b (or b), the cases are
+//   a and b carried by k (or k):     0 (the pair moves rigidly; S . Y S is
 //                                    frame-invariant)
-//   a strictly above k, k above b    S_a . (S_k x* F_b),   F_b = Ic_seg(b) S_b
-//   (or k = b):
-//   b strictly above k:              S_a . (D_k S_b),      D_k the rate of Ic_seg(k) under S_k
-// and dM/dx_c sums multiplier_k dM/dq_k over the dofs k that x_c drives
-// (each term also carries m_a m_b). Dofs that are not on b's path or below
-// it contribute 0. A free root's six dofs are the chain tx, ty, tz, psi,
-// theta, phi, so the Euler-angle terms dT/dphi, dT/dtheta come out of the
-// same rule (dS_phi/dpsi = S_psi x S_phi, ...). Work: O(dofs x depth^2).
+//   a not carried, b carried or k:   S_a . (S_k x* F_b),   F_b = Ic_seg(b) S_b
+//   b not carried, above k or in     S_a . (D_k S_b),      D_k the rate of Ic_seg(k) under S_k
+//   k's block after k:
+// ("not carried": strictly above k, or in k's block after it), and dH along
+// nu_c sums multiplier_k dH/dq_k over the dofs k that nu_c drives (each term
+// also carries m_a m_b). Dofs that are not on b's path or below it
+// contribute 0. Work: O(dofs x depth^2). In x, with M = A^T H A
+// (motion_coordinates.h) and dA_c = dA/dx_c (a free root's theta and psi):
+//   dM/dx_c = A^T (dH along A e_c) A + dA_c^T H A + A^T H dA_c.
 //
 // Checked against the complex step of crba and against forward-mode AutoDiff
 // (test_body_algorithms.cpp); a free object takes the closed form of
-// free_body/mass_matrix.h (math.md) in massMatrixDerivativesRowMajor.
+// free_body/mass_matrix.h in massMatrixDerivativesRowMajor.
 #pragma once
 
 #include "diff_rigid_body/crba.h"
@@ -37,53 +40,99 @@ void addSymmetric(Scalar* dM, std::size_t d, int c, int row, int col, const Scal
     matrix[static_cast<std::size_t>(col) * d + static_cast<std::size_t>(row)] += value;
 }
 
-/// Case "a strictly above k, k above b or k = b", for every dof b.
+/// S_a . G added to dH along dof k's coordinate, at (a, b) and (b, a).
+template <typename Scalar>
+void addPairTerm(const BodyModel& model, const BodyWorkspace<Scalar>& ws, Scalar* dM, int k, int a, int b,
+                 const Force<Scalar>& G)
+{
+  const Dof &dof_k = model.dofs[static_cast<std::size_t>(k)], &dof_a = model.dofs[static_cast<std::size_t>(a)],
+            &dof_b = model.dofs[static_cast<std::size_t>(b)];
+  const Scalar value = Scalar(dof_k.multiplier * dof_b.multiplier * dof_a.multiplier) *
+                       spatial::power(ws.S[static_cast<std::size_t>(a)], G);
+  addSymmetric(dM, model.coordinates, dof_k.coordinate, dof_a.coordinate, dof_b.coordinate, value, a == b);
+}
+
+/// Case "a not carried, b carried by k (or k)", for every dof b.
 template <typename Scalar>
 void addCarriedMomentumTerms(const BodyModel& model, const BodyWorkspace<Scalar>& ws, Scalar* dM)
 {
-  const std::size_t d = model.coordinates;
+  const auto parent = [&](int k) { return model.dofs[static_cast<std::size_t>(k)].parent; };
   for (std::size_t b = 0; b < model.dofs.size(); ++b)
   {
-    const Dof& dof_b = model.dofs[b];
-    for (int k = static_cast<int>(b); k >= 0; k = model.dofs[static_cast<std::size_t>(k)].parent)
+    const int deeper = static_cast<int>(b);
+    for (int k = deeper; k >= 0; k = parent(k))
     {
-      const Dof& dof_k = model.dofs[static_cast<std::size_t>(k)];
-      if (dof_k.parent < 0)
-        break;
+      const int block_last = model.dofs[static_cast<std::size_t>(k)].block_last;
+      if (k != deeper && block_last >= deeper)
+        continue;  // b in k's block: not carried
       const Force<Scalar> G = spatial::crossForce(ws.S[static_cast<std::size_t>(k)], ws.momentum[b]);
-      const double mkb = dof_k.multiplier * dof_b.multiplier;
-      for (int a = dof_k.parent; a >= 0; a = model.dofs[static_cast<std::size_t>(a)].parent)
-      {
-        const Dof& dof_a = model.dofs[static_cast<std::size_t>(a)];
-        const Scalar value = Scalar(mkb * dof_a.multiplier) * spatial::power(ws.S[static_cast<std::size_t>(a)], G);
-        addSymmetric(dM, d, dof_k.coordinate, dof_a.coordinate, dof_b.coordinate, value, false);
-      }
+      for (int a = parent(k); a >= 0; a = parent(a))
+        addPairTerm(model, ws, dM, k, a, deeper, G);
+      if (k != deeper)
+        for (int a = k + 1; a <= block_last; ++a)
+          addPairTerm(model, ws, dM, k, a, deeper, G);
     }
   }
 }
 
-/// Case "b strictly above k", for every dof k.
+/// Case "b not carried: above k, or in k's block after k", for every dof k.
 template <typename Scalar>
 void addCarriedInertiaTerms(const BodyModel& model, BodyWorkspace<Scalar>& ws, Scalar* dM)
 {
-  const std::size_t d = model.coordinates;
+  const auto parent = [&](int k) { return model.dofs[static_cast<std::size_t>(k)].parent; };
   for (std::size_t k = 0; k < model.dofs.size(); ++k)
   {
     const Dof& dof_k = model.dofs[k];
-    if (dof_k.parent < 0)
+    const int moving = static_cast<int>(k);
+    if (dof_k.parent < 0 && dof_k.block_last == moving)
       continue;
     const Inertia<Scalar>& D = ws.carried_rate[k] =
         spatial::carriedInertiaRate(ws.S[k], ws.composite[static_cast<std::size_t>(dof_k.segment)]);
-    for (int b = dof_k.parent; b >= 0; b = model.dofs[static_cast<std::size_t>(b)].parent)
-    {
-      const Dof& dof_b = model.dofs[static_cast<std::size_t>(b)];
+    const auto addColumn = [&](int b) {
       const Force<Scalar> P = spatial::momentum(D, ws.S[static_cast<std::size_t>(b)]);
-      const double mkb = dof_k.multiplier * dof_b.multiplier;
-      for (int a = b; a >= 0; a = model.dofs[static_cast<std::size_t>(a)].parent)
+      for (int a = b; a >= 0; a = parent(a))
+        addPairTerm(model, ws, dM, moving, a, b, P);
+    };
+    for (int b = dof_k.parent; b >= 0; b = parent(b))
+      addColumn(b);
+    for (int b = moving + 1; b <= dof_k.block_last; ++b)
+      addColumn(b);
+  }
+}
+
+/// dH along nu (d matrices at dM) turned into dM/dx in place, for a free
+/// root (see the header comment), with H and the chart in ws.
+template <typename Scalar>
+void massMatrixDerivativesToCoordinates(const BodyModel& model, const BodyWorkspace<Scalar>& ws, Scalar* dM)
+{
+  using RowMajor = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const Eigen::Index d = static_cast<Eigen::Index>(model.coordinates);
+  const Matrix3<Scalar>& T = ws.chart.T;
+  for (Eigen::Index e = 0; e < d * d; ++e)  // dH along A e_c = sum_k T(k, c) dH along nu_k
+  {
+    const Vector3<Scalar> along(dM[e], dM[d * d + e], dM[2 * d * d + e]);
+    for (int c = 0; c < 3; ++c)
+      dM[c * d * d + e] = T(0, c) * along[0] + T(1, c) * along[1] + T(2, c) * along[2];
+  }
+  for (Eigen::Index c = 0; c < d; ++c)
+  {
+    Eigen::Map<RowMajor> D(dM + c * d * d, d, d);
+    symmetricToCoordinates(model, ws, D);
+  }
+  for (int c = THETA; c <= PSI; ++c)  // + X + X^T, X = A^T H dA_c (its first three columns)
+  {
+    const Matrix3<Scalar> dT = ws.chart.derivative(c);
+    const Matrix3<Scalar> top = T.transpose() * (ws.H.template topLeftCorner<3, 3>() * dT);
+    Eigen::Map<RowMajor> D(dM + c * d * d, d, d);
+    for (Eigen::Index i = 0; i < d; ++i)
+    {
+      const Eigen::Matrix<Scalar, 1, 3> y =
+          i < 3 ? Eigen::Matrix<Scalar, 1, 3>(top.row(i)) :
+                  Eigen::Matrix<Scalar, 1, 3>(ws.H.row(i).template head<3>() * dT);
+      for (int k = 0; k < 3; ++k)
       {
-        const Dof& dof_a = model.dofs[static_cast<std::size_t>(a)];
-        const Scalar value = Scalar(mkb * dof_a.multiplier) * spatial::power(ws.S[static_cast<std::size_t>(a)], P);
-        addSymmetric(dM, d, dof_k.coordinate, dof_a.coordinate, dof_b.coordinate, value, a == b);
+        D(i, k) += y[k];
+        D(k, i) += y[k];
       }
     }
   }
@@ -91,8 +140,8 @@ void addCarriedInertiaTerms(const BodyModel& model, BodyWorkspace<Scalar>& ws, S
 }  // namespace detail
 
 /// dM/dx_j, j = 0..d-1, into dM (d^3 values: matrix j row-major at j d^2)
-/// from the kinematics and composite inertias in ws (crba first); see the
-/// header comment.
+/// from the kinematics, composite inertias and H in ws (crba first); see
+/// the header comment.
 template <typename Scalar>
 void massMatrixDerivativesFromCrba(const BodyModel& model, BodyWorkspace<Scalar>& ws, Scalar* dM)
 {
@@ -100,6 +149,8 @@ void massMatrixDerivativesFromCrba(const BodyModel& model, BodyWorkspace<Scalar>
   std::fill(dM, dM + d * d * d, Scalar(0));
   detail::addCarriedMomentumTerms(model, ws, dM);
   detail::addCarriedInertiaTerms(model, ws, dM);
+  if (model.hasFreeRoot())
+    detail::massMatrixDerivativesToCoordinates(model, ws, dM);
 }
 
 /// dM/dx at x into dM (d^3 values): kinematics, CRBA, then the derivatives.

@@ -4,26 +4,30 @@
 //   tau = M(x) x'' + c(x, x') + g(x)
 // of interface.md, Version 3, for x' and x'' of d values each.
 //
-// Forward, over the dofs k (parents first), with q'_k = m_k x'[c_k] and
-// q''_k = m_k x''[c_k] the dof's velocity and acceleration (m_k its mimic
-// multiplier):
+// It runs in motion coordinates (body_model.h): nu = A x', nu' = A x'' + Q,
+// tau = A^T tau_nu (motion_coordinates.h). Forward, over the dofs k (parents
+// first), with q'_k = m_k nu[c_k] and q''_k = m_k nu'[c_k] the dof's
+// velocity and acceleration (m_k its mimic multiplier):
 //   v_k = v_parent + S_k q'_k
-//   a_k = a_parent + S_k q''_k + v_k x S_k q'_k     (dS_k/dt = v_parent x S_k)
+//   a_k = a_parent + S_k q''_k + v_carrier x S_k q'_k   (dS_k/dt = v_carrier x S_k)
+// where the carrier is the parent (then v_carrier x S_k = v_k x S_k), but for
+// a free root's rotations, whose axes only move with the COM: for them the
+// sum is (0, t' x w), and a_root = (w', t'' + t' x w) at r = t.
 // from v = 0 and a = (0, -gamma) above the root: gravity gamma [m/s^2] enters
 // as an upward acceleration of the fixed frame. A segment moves with its last
 // dof; its Newton-Euler force, with Y_s its inertia about r,
 //   f_s = Y_s a_s + v_s x* Y_s v_s,
 // is summed over each subtree (children first), and
 //   tau[c_k] += m_k S_k . F_seg(k).
-// For a free root, S_k are the Euler-angle motions of kinematics.h, so its
-// entries are (T^T n, f): the moment n about its COM and the force f, fixed
-// axes. The velocity terms are c = tau(x, x', 0) with gamma = 0, the gravity
-// terms g = tau(x, 0, 0) (math.md derives both for one free body from the
-// Lagrangian). O(dofs); nothing is inverted, so every term stays finite at
-// gimbal lock.
+// For a free root, tau_nu's entries are (n, f): the moment n about its COM
+// and the force f, fixed axes, so tau's are (T^T n, f). The velocity terms are c = tau(x, x', 0) with gamma = 0, the gravity
+// terms g = tau(x, 0, 0) (docs/derivation.md derives both for one free
+// body from the Lagrangian). O(dofs); nothing is inverted, so every term
+// stays finite at gimbal lock.
 #pragma once
 
 #include "diff_rigid_body/kinematics.h"
+#include "diff_rigid_body/motion_coordinates.h"
 
 namespace diff_rigid_body
 {
@@ -42,7 +46,7 @@ void segmentInertias(const BodyModel& model, BodyWorkspace<Scalar>& ws)
 }
 
 /// Forward pass: per dof velocity and acceleration (ws.dof_velocity,
-/// ws.dof_acceleration) from the kinematics in ws.
+/// ws.dof_acceleration) from the kinematics in ws, at nu and nu' (null: zeros).
 template <typename Scalar>
 void propagateMotion(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Scalar* xd, const Scalar* xdd,
                      const Vector3<Scalar>& gravity)
@@ -69,7 +73,10 @@ void propagateMotion(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Sc
     }
     v.w += S.w * qd;
     v.v += S.v * qd;
-    const Motion<Scalar> bias = spatial::crossMotion(v, S);
+    const Motion<Scalar> bias =
+        dof.carrier == dof.parent ? spatial::crossMotion(v, S) :
+        dof.carrier < 0           ? Motion<Scalar>() :
+                                    spatial::crossMotion(ws.dof_velocity[static_cast<std::size_t>(dof.carrier)], S);
     a.w += S.w * qdd + bias.w * qd;
     a.v += S.v * qdd + bias.v * qd;
   }
@@ -106,31 +113,57 @@ void accumulateForces(const BodyModel& model, BodyWorkspace<Scalar>& ws, Scalar*
 }
 }  // namespace detail
 
-/// tau = M(x) x'' + c(x, x') + g(x) into `tau` (d values) from the
-/// kinematics in ws (forwardKinematics at x). A null xd or xdd means zeros.
+/// tau_nu = H nu' + (c + g in nu) into `tau` (d values) from the
+/// kinematics in ws (forwardKinematics at x), at nu and nu' (null: zeros).
 /// gravity: gamma in the fixed frame [m/s^2].
 /// `inertias_ready`: ws.body_inertia already holds them for this kinematics
 /// (crba computed them).
 template <typename Scalar>
-void inverseDynamicsFromKinematics(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Scalar* xd,
-                                   const Scalar* xdd, const Vector3<Scalar>& gravity, Scalar* tau,
-                                   bool inertias_ready = false)
+void inverseDynamicsInMotion(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Scalar* nu,
+                             const Scalar* nu_dot, const Vector3<Scalar>& gravity, Scalar* tau,
+                             bool inertias_ready = false)
 {
   if (!inertias_ready)
     detail::segmentInertias(model, ws);
-  detail::propagateMotion(model, ws, xd, xdd, gravity);
+  detail::propagateMotion(model, ws, nu, nu_dot, gravity);
   detail::accumulateForces(model, ws, tau);
 }
 
-/// tau at (x, x', x''): forward kinematics, then inverseDynamicsFromKinematics.
+/// tau = M(x) x'' + c(x, x') + g(x) at (x, x', x'') into `tau` (d values);
+/// a null xd or xdd means zeros.
 template <typename Scalar>
 void inverseDynamics(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Scalar* x, const Scalar* xd,
                      const Scalar* xdd, const Vector3<Scalar>& gravity, Scalar* tau)
 {
   forwardKinematics(model, ws, x);
-  inverseDynamicsFromKinematics(model, ws, xd, xdd, gravity, tau);
+  const Scalar* nu_dot = motionAccelerations(model, ws, xd, xdd);
+  inverseDynamicsInMotion(model, ws, motionRates(model, ws, xd), nu_dot, gravity, tau);
+  forceToCoordinates(model, ws, tau);
 }
 
+/// tau, the velocity terms c = tau(x, x', 0) with gamma = 0 and the gravity
+/// terms g = tau(x, 0, 0) (d values each) from one kinematics: the node's
+/// inverse dynamics.
+template <typename Scalar>
+void inverseDynamicsTerms(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Scalar* x, const Scalar* xd,
+                          const Scalar* xdd, const Vector3<Scalar>& gravity, Scalar* tau, Scalar* velocity_terms,
+                          Scalar* gravity_terms)
+{
+  forwardKinematics(model, ws, x);
+  detail::segmentInertias(model, ws);
+  const Scalar* none = nullptr;
+  const Scalar* nu = motionRates(model, ws, xd);
+  inverseDynamicsInMotion(model, ws, nu, motionAccelerations(model, ws, xd, none), Vector3<Scalar>::Zero().eval(),
+                          velocity_terms, true);
+  inverseDynamicsInMotion(model, ws, none, none, gravity, gravity_terms, true);
+  inverseDynamicsInMotion(model, ws, nu, motionAccelerations(model, ws, xd, xdd), gravity, tau, true);
+  for (Scalar* out : { tau, velocity_terms, gravity_terms })
+    forceToCoordinates(model, ws, out);
+}
+
+extern template void inverseDynamicsTerms<double>(const BodyModel&, BodyWorkspace<double>&, const double*,
+                                                  const double*, const double*, const Vector3<double>&, double*,
+                                                  double*, double*);
 extern template void inverseDynamics<double>(const BodyModel&, BodyWorkspace<double>&, const double*,
                                              const double*, const double*, const Vector3<double>&, double*);
 

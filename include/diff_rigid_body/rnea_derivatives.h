@@ -1,16 +1,19 @@
 // Analytic derivatives of inverse dynamics (rnea.h), dtau/dx and dtau/dx',
 // in the fixed frame about r (after Carpentier and Mansard, "Analytical
 // derivatives of rigid body dynamics algorithms", RSS 2018; derived anew for
-// these coordinates in docs/derivation.md).
+// these coordinates in docs/derivation.md, "Derivatives of inverse dynamics").
 //
-// Moving dof j (its value, at fixed x' and x'') carries its subtree: unit
-// motions, inertias and the Newton-Euler forces f_s = Y_s a_s + v_s x* Y_s v_s
-// of the segments it moves change as if carried by S_j, except that their
-// velocity and acceleration also lose what dof j's own motion put there:
+// In motion coordinates (body_model.h): moving dof j (along S_j, at fixed nu
+// and nu') carries the segments it moves and the dofs below its block:
+// their unit motions, inertias and Newton-Euler forces
+// f_s = Y_s a_s + v_s x* Y_s v_s change as if carried by S_j, except that
+// their velocity and acceleration also lose what dof j's block put there:
 //   df_s/dq_j  = S_j x* f_s - Y_s w_j - B_s u_j,
-//   df_s/dq'_j = B_s S_j - 2 Y_s u_j,
-// with u_j = S_j x v_j, w_j = S_j x a_j - u_j x v_j (v_j, a_j: the motion of
-// what dof j moves, gravity included in a_j), and B_s the linear map
+//   df_s/dq'_j = B_s S_j - Y_s ubar_j,
+// with l = the last dof of j's block (j itself for a 1-dof joint),
+// u_j = S_j x v_l, w_j = S_j x a_l - u_j x v_l (v_l, a_l: the motion of what
+// dof l moves, gravity included in a_l), ubar_j = u_j - v_carrier x S_j
+// (= 2 u_j for a 1-dof joint), and B_s the linear map
 //   B_s m = Y_s (m x v_s) + m x* (Y_s v_s) + v_s x* (Y_s m)
 //         = (T_s m.w, -2 p_s x m.w),
 //   T_s = [w]I - I[w] - [v][h] - [h][v] - [I w + h x v],  p_s = m v + w x h,
@@ -18,15 +21,21 @@
 // its argument. Summed over subtrees (Ic, F, T^c, p^c) and paired with the
 // unit motions (tau_i = S_i . F_seg(i)), for dofs i, j:
 //   j an ancestor of i, or i:   dtau_i/dq_j  = -F^M_i . w_j - G_i . u_j.w
-//                               dtau_i/dq'_j =  G_i . S_j.w - 2 F^M_i . u_j
-//   i strictly above j:         dtau_i/dq_j  =  S_i . (S_j x* F_j - Ic_j w_j - B^c_j u_j)
-//                               dtau_i/dq'_j =  S_i . (B^c_j S_j - 2 Ic_j u_j)
+//     (S_i carried by j)        dtau_i/dq'_j =  G_i . S_j.w - F^M_i . ubar_j
+//   i strictly above j, or in   dtau_i/dq_j  =  S_i . (S_j x* F_j - Ic_j w_j - B^c_j u_j)
+//     j's block after j:        (and dtau_i/dq'_j as the first line for the block)
+//   i strictly above j:         dtau_i/dq'_j =  S_i . (B^c_j S_j - Ic_j ubar_j)
 // where F^M_i = Ic_i S_i (the CRBA's momentum) and G_i = T^c_i^T S_i.w -
 // 2 S_i.v x p^c_i (the angular part of B^c_i^T S_i); every other pair is 0.
-// In x: d/dx_c sums m_j d/dq_j over the dofs j that x_c drives, and
-// tau[c_i] carries m_i. Work: O(dofs x depth), no 6 x 6 matrix.
+// In nu: d/dq along nu_c sums m_j d/dq_j over the dofs j that nu_c drives,
+// and tau[c_i] carries m_i. Work: O(dofs x depth), no 6 x 6 matrix.
 //
-// dtau/dx' = 2 C, the Christoffel Coriolis matrix of interface.md, Version 3.
+// In x (motion_coordinates.h), with tau = A^T tau_nu(nu = A x', nu' = A x'' + Q):
+//   dtau/dx_c  = A^T [D_q A e_c + D_nu dA_c x' + H (dA_c x'' + dQ/dx_c)] + dA_c^T tau_nu
+//   dtau/dx'   = A^T [D_nu A + H dQ/dx']
+// (D_q, D_nu the derivatives in nu above, dA_c = dA/dx_c; only a free root's
+// theta and psi columns carry the dA and dQ terms). dtau/dx' = 2 C, the
+// Christoffel Coriolis matrix of the equations of motion (README, "Dynamics").
 #pragma once
 
 #include "diff_rigid_body/crba.h"
@@ -88,12 +97,25 @@ void dofDerivativeTerms(const BodyModel& model, BodyWorkspace<Scalar>& ws, std::
 {
   for (std::size_t k = 0; k < model.dofs.size(); ++k)
   {
-    const std::size_t s = static_cast<std::size_t>(model.dofs[k].segment);
+    const Dof& dof = model.dofs[k];
+    const std::size_t s = static_cast<std::size_t>(dof.segment);
+    const std::size_t last = static_cast<std::size_t>(dof.block_last);
     const Motion<Scalar>& S = ws.S[k];
     auto& terms = ws.dof_terms[k];
-    terms.u = spatial::crossMotion(S, ws.dof_velocity[k]);
-    const Motion<Scalar> Sa = spatial::crossMotion(S, ws.dof_acceleration[k]);
-    const Motion<Scalar> uv = spatial::crossMotion(terms.u, ws.dof_velocity[k]);
+    terms.u = spatial::crossMotion(S, ws.dof_velocity[last]);
+    if (dof.block_last == static_cast<int>(k) && dof.carrier == dof.parent)  // 1-dof: v_carrier x S_k = -u_k
+    {
+      terms.ubar.w = Scalar(2) * terms.u.w;
+      terms.ubar.v = Scalar(2) * terms.u.v;
+    }
+    else
+    {
+      const Motion<Scalar> beta = dof.carrier < 0 ? Motion<Scalar>() : spatial::crossMotion(ws.dof_velocity[static_cast<std::size_t>(dof.carrier)], S);
+      terms.ubar.w = terms.u.w - beta.w;
+      terms.ubar.v = terms.u.v - beta.v;
+    }
+    const Motion<Scalar> Sa = spatial::crossMotion(S, ws.dof_acceleration[last]);
+    const Motion<Scalar> uv = spatial::crossMotion(terms.u, ws.dof_velocity[last]);
     terms.w.w = Sa.w - uv.w;
     terms.w.v = Sa.v - uv.v;
     const auto& rate = ws.composite_velocity_rate[s];
@@ -105,30 +127,29 @@ void dofDerivativeTerms(const BodyModel& model, BodyWorkspace<Scalar>& ws, std::
     terms.moved.n = carried.n - Iw.n - Bu.n;
     terms.moved.f = carried.f - Iw.f - Bu.f;
     const Force<Scalar> BS = applyVelocityRate(ws, s, S.w);
-    const Force<Scalar> Iu = spatial::momentum(ws.composite[s], terms.u);
-    moved_rate[k].n = BS.n - Scalar(2) * Iu.n;
-    moved_rate[k].f = BS.f - Scalar(2) * Iu.f;
+    const Force<Scalar> Iu = spatial::momentum(ws.composite[s], terms.ubar);
+    moved_rate[k].n = BS.n - Iu.n;
+    moved_rate[k].f = BS.f - Iu.f;
   }
 }
 }  // namespace detail
 
-/// dtau/dx and dtau/dx' (d x d, column-major Eigen matrices of ws's scalar:
-/// row = tau component, column = coordinate) at (x, x', x''), and tau into
-/// ws.tau. Also leaves the kinematics, composite inertias and momenta in ws.
+/// dtau_nu/dq and dtau_nu/dnu (d x d, column-major Eigen matrices of ws's
+/// scalar: row = tau_nu component, column = direction in nu) at nu, nu'
+/// (null: zeros), from the kinematics and composite inertias in ws; tau_nu
+/// into ws.tau.
 template <typename Scalar>
-void inverseDynamicsDerivatives(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Scalar* x, const Scalar* xd,
-                                const Scalar* xdd, const Vector3<Scalar>& gravity,
-                                typename BodyWorkspace<Scalar>::MatrixX& dtau_dx,
-                                typename BodyWorkspace<Scalar>::MatrixX& dtau_dxd)
+void inverseDynamicsDerivativesInMotion(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Scalar* nu,
+                                        const Scalar* nu_dot, const Vector3<Scalar>& gravity,
+                                        typename BodyWorkspace<Scalar>::MatrixX& dtau_dq,
+                                        typename BodyWorkspace<Scalar>::MatrixX& dtau_dnu)
 {
-  forwardKinematics(model, ws, x);
-  detail::compositeInertias(model, ws);
-  inverseDynamicsFromKinematics(model, ws, xd, xdd, gravity, ws.tau.data(), /*inertias_ready=*/true);
+  inverseDynamicsInMotion(model, ws, nu, nu_dot, gravity, ws.tau.data(), /*inertias_ready=*/true);
   detail::velocityRates(model, ws);
   std::vector<Force<Scalar>>& moved_rate = ws.momentum_rate;
   detail::dofDerivativeTerms(model, ws, moved_rate);
-  dtau_dx.setZero();
-  dtau_dxd.setZero();
+  dtau_dq.setZero();
+  dtau_dnu.setZero();
   for (std::size_t i = 0; i < model.dofs.size(); ++i)
   {
     const Dof& dof_i = model.dofs[i];
@@ -141,20 +162,78 @@ void inverseDynamicsDerivatives(const BodyModel& model, BodyWorkspace<Scalar>& w
       const Dof& dof_j = model.dofs[static_cast<std::size_t>(j)];
       const auto& terms_j = ws.dof_terms[static_cast<std::size_t>(j)];
       const Scalar m(dof_i.multiplier * dof_j.multiplier);
-      dtau_dx(dof_i.coordinate, dof_j.coordinate) -=
-          m * (spatial::power(terms_j.w, FM) + spatial::dot(terms_i.gamma.n, terms_j.u.w));
-      dtau_dxd(dof_i.coordinate, dof_j.coordinate) +=
-          m * (spatial::dot(terms_i.gamma.n, ws.S[static_cast<std::size_t>(j)].w) -
-               Scalar(2) * spatial::power(terms_j.u, FM));
+      if (j != static_cast<int>(i) && dof_j.block_last >= static_cast<int>(i))  // i in j's block: not carried
+        dtau_dq(dof_i.coordinate, dof_j.coordinate) += m * spatial::power(ws.S[i], terms_j.moved);
+      else
+        dtau_dq(dof_i.coordinate, dof_j.coordinate) -=
+            m * (spatial::power(terms_j.w, FM) + spatial::dot(terms_i.gamma.n, terms_j.u.w));
+      dtau_dnu(dof_i.coordinate, dof_j.coordinate) +=
+          m * (spatial::dot(terms_i.gamma.n, ws.S[static_cast<std::size_t>(j)].w) - spatial::power(terms_j.ubar, FM));
       if (j == static_cast<int>(i))
         continue;
       // i below j: row j, column i.
-      dtau_dx(dof_j.coordinate, dof_i.coordinate) +=
+      dtau_dq(dof_j.coordinate, dof_i.coordinate) +=
           m * spatial::power(ws.S[static_cast<std::size_t>(j)], terms_i.moved);
-      dtau_dxd(dof_j.coordinate, dof_i.coordinate) +=
+      dtau_dnu(dof_j.coordinate, dof_i.coordinate) +=
           m * spatial::power(ws.S[static_cast<std::size_t>(j)], moved_rate[i]);
     }
   }
+}
+
+namespace detail
+{
+/// The derivatives in nu (dtau_dx = D_q, dtau_dxd = D_nu) turned into x, in
+/// place, for a free root (see the header comment); ws.tau holds tau_nu and
+/// the composite inertias are in ws.
+template <typename Scalar>
+void inverseDynamicsDerivativesToCoordinates(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Scalar* xd,
+                                             const Scalar* xdd, typename BodyWorkspace<Scalar>::MatrixX& dtau_dx,
+                                             typename BodyWorkspace<Scalar>::MatrixX& dtau_dxd)
+{
+  const FreeRootChart<Scalar>& chart = ws.chart;
+  const Vector3<Scalar> rates = xd ? Vector3<Scalar>(Eigen::Map<const Vector3<Scalar>>(xd)) : Vector3<Scalar>::Zero();
+  const Vector3<Scalar> accelerations =
+      xdd ? Vector3<Scalar>(Eigen::Map<const Vector3<Scalar>>(xdd)) : Vector3<Scalar>::Zero();
+  rotationColumnsOfH(model, ws);
+  const auto& H_w = ws.rotation_columns;
+  const Matrix3<Scalar> dQ_dangles = chart.velocityProductByAngles(rates.data());
+  auto& chart_terms = ws.chart_columns;  // column c - THETA: the dA_c and dQ/dx_c terms
+  for (int c = THETA; c <= PSI; ++c)
+  {
+    const Matrix3<Scalar> dT = chart.derivative(c);
+    const Vector3<Scalar> by_rates = dT * rates, by_accelerations = dT * accelerations + dQ_dangles.col(c);
+    chart_terms.col(c - THETA).noalias() = dtau_dxd.template leftCols<3>() * by_rates;
+    chart_terms.col(c - THETA).noalias() += H_w * by_accelerations;
+  }
+  const Matrix3<Scalar> dQ_drates = chart.velocityProductByRates(rates.data());
+  columnsToCoordinates(model, ws, dtau_dx);
+  for (int c = THETA; c <= PSI; ++c)
+    dtau_dx.col(c) += chart_terms.col(c - THETA);
+  columnsToCoordinates(model, ws, dtau_dxd);
+  dtau_dxd.template leftCols<3>().noalias() += H_w * dQ_drates;
+  rowsToCoordinates(model, ws, dtau_dx);
+  rowsToCoordinates(model, ws, dtau_dxd);
+  const Vector3<Scalar> moment = ws.tau.template head<3>();
+  for (int c = THETA; c <= PSI; ++c)
+    dtau_dx.col(c).template head<3>() += chart.derivative(c).transpose() * moment;
+}
+}  // namespace detail
+
+/// dtau/dx and dtau/dx' (d x d, column-major Eigen matrices of ws's scalar:
+/// row = tau component, column = coordinate) at (x, x', x'') (null: zeros).
+/// Also leaves the kinematics, composite inertias, momenta and tau_nu in ws.
+template <typename Scalar>
+void inverseDynamicsDerivatives(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Scalar* x, const Scalar* xd,
+                                const Scalar* xdd, const Vector3<Scalar>& gravity,
+                                typename BodyWorkspace<Scalar>::MatrixX& dtau_dx,
+                                typename BodyWorkspace<Scalar>::MatrixX& dtau_dxd)
+{
+  forwardKinematics(model, ws, x);
+  detail::compositeInertias(model, ws);
+  const Scalar* nu_dot = motionAccelerations(model, ws, xd, xdd);
+  inverseDynamicsDerivativesInMotion(model, ws, motionRates(model, ws, xd), nu_dot, gravity, dtau_dx, dtau_dxd);
+  if (model.hasFreeRoot())
+    detail::inverseDynamicsDerivativesToCoordinates(model, ws, xd, xdd, dtau_dx, dtau_dxd);
 }
 
 extern template void inverseDynamicsDerivatives<double>(const BodyModel&, BodyWorkspace<double>&, const double*,

@@ -1,7 +1,9 @@
-// M = L^T D L along the body's tree (Featherstone 2008, section 6.3, "LTDL"),
-// for forward dynamics (forward_dynamics.h).
+// H = L^T D L along the body's tree (Featherstone 2008, section 6.3, "LTDL"),
+// for forward dynamics (forward_dynamics.h). H is the mass matrix in motion
+// coordinates (crba.h): well conditioned where M = A^T H A is not (near a
+// free root's gimbal lock), so forward dynamics factors H, never M.
 //
-// In dof order M has the tree's sparsity: M(i, j) != 0 only when one of the
+// In dof order H has the tree's sparsity: H(i, j) != 0 only when one of the
 // dofs i, j is an ancestor of the other. Eliminating from the leaves up,
 // row k only ever updates the rows of its ancestors, so no fill-in occurs:
 //   for k = last..0, for i = each ancestor of k:
@@ -10,9 +12,10 @@
 // is the dense LDL^T, which serves bodies with mimic joints (several dofs per
 // coordinate). BodyModel::factor_coordinate and factor_parent give the order.
 //
-// M is positive semidefinite; a pivot D_k <= d eps max_i M_ii (rounding of
-// a zero) means M is singular: at gimbal lock of a free root, or a coordinate
-// that moves no mass. The factorization then reports the row's coordinate.
+// H is positive semidefinite; a pivot D_k <= d eps max_i H_ii (rounding of
+// a zero) means H is singular: a coordinate that moves no mass (or a free
+// root's rotation that moves no inertia). The factorization then reports
+// the row's coordinate.
 #pragma once
 
 #include <algorithm>
@@ -41,7 +44,7 @@ double pivotMagnitude(const std::complex<Real>& value)
 }
 }  // namespace detail
 
-/// Factors ws.M into ws.factor (rows and columns in factorization order).
+/// Factors ws.H into ws.factor (rows and columns in factorization order).
 /// Returns -1, or the coordinate of the first pivot found singular.
 template <typename Scalar>
 int factorMassMatrix(const BodyModel& model, BodyWorkspace<Scalar>& ws)
@@ -50,7 +53,7 @@ int factorMassMatrix(const BodyModel& model, BodyWorkspace<Scalar>& ws)
   auto& H = ws.factor;
   for (int r = 0; r < d; ++r)
     for (int c = 0; c < d; ++c)
-      H(r, c) = ws.M(model.factor_coordinate[static_cast<std::size_t>(r)], model.factor_coordinate[static_cast<std::size_t>(c)]);
+      H(r, c) = ws.H(model.factor_coordinate[static_cast<std::size_t>(r)], model.factor_coordinate[static_cast<std::size_t>(c)]);
   double largest = 0.0;
   for (int k = 0; k < d; ++k)
     largest = std::max(largest, detail::pivotMagnitude(H(k, k)));
@@ -71,7 +74,7 @@ int factorMassMatrix(const BodyModel& model, BodyWorkspace<Scalar>& ws)
   return singular;
 }
 
-/// Solves M y = b for b given in x order (d values at `b`), in place, with
+/// Solves H y = b for b given in nu order (d values at `b`), in place, with
 /// the factorization in ws. ws.solution is used as scratch.
 template <typename Scalar>
 void solveMassMatrix(const BodyModel& model, BodyWorkspace<Scalar>& ws, Scalar* b)
@@ -94,7 +97,7 @@ void solveMassMatrix(const BodyModel& model, BodyWorkspace<Scalar>& ws, Scalar* 
     b[model.factor_coordinate[static_cast<std::size_t>(k)]] = y[k];
 }
 
-/// Solves M Y = B in place for every column of B (d x n, x order in rows),
+/// Solves H Y = B in place for every column of B (d x n, nu order in rows),
 /// with the factorization in ws: the same walks as solveMassMatrix, each
 /// step a whole row of B at once (ws.factor_rows is the scratch, factor
 /// rows as its columns, so every update is contiguous).

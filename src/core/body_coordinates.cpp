@@ -93,17 +93,25 @@ void buildDofs(const std::vector<JointCoordinate>& coordinates, BodyModel& body)
     segment.first_dof = static_cast<int>(body.dofs.size());
     if (segment.joint_type == JointType::Free)
     {
-      // tx, ty, tz, psi, theta, phi: each the parent of the next.
-      static constexpr int kChain[6] = { TX, TY, TZ, PSI, THETA, PHI };
+      // tx, ty, tz (nu = x' there), then wx, wy, wz (nu[0..2] = w): each the
+      // parent of the next; the rotations are one block carried by tz.
+      static constexpr int kChain[6] = { TX, TY, TZ, 0, 1, 2 };
       segment.dof_count = 6;
       segment.offset = 0.0;
+      const int first = segment.first_dof;
       for (int k = 0; k < 6; ++k)
-        body.dofs.push_back({ k == 0 ? parent_dof : segment.first_dof + k - 1, static_cast<int>(s), kChain[k], 1.0 });
+      {
+        const int parent = k == 0 ? parent_dof : first + k - 1;
+        const bool rotation = k >= 3;
+        body.dofs.push_back({ parent, static_cast<int>(s), kChain[k], 1.0, rotation ? first + 2 : parent,
+                              rotation ? first + 5 : first + k });
+      }
       continue;
     }
     segment.dof_count = 1;
     segment.offset = coordinates[s].offset;
-    body.dofs.push_back({ parent_dof, static_cast<int>(s), coordinates[s].coordinate, coordinates[s].multiplier });
+    body.dofs.push_back({ parent_dof, static_cast<int>(s), coordinates[s].coordinate, coordinates[s].multiplier,
+                          parent_dof, segment.first_dof });
   }
   body.coordinates = body.rootCoordinates() + body.joint_names.size();
   body.revolute_segments.clear();

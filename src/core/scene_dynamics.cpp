@@ -65,15 +65,20 @@ void writeRowMajor(const Eigen::MatrixXd& matrix, double scale, double* out)
       out[r * d + c] = scale * matrix(r, c);
 }
 
-/// Why M is singular at x in `coordinate` (factorMassMatrix's report).
+/// Why forward dynamics is undefined at x: the coordinate forwardDynamics
+/// reported (THETA at a free root's gimbal lock, else a singular pivot of H).
 std::string singularReason(const BodyModel& body, const double* x, int coordinate)
 {
   std::ostringstream why;
   why.precision(17);
-  if (body.hasFreeRoot() && coordinate < 3)
-    why << "its rotation coordinates (phi, theta, psi) are singular: pitch theta = " << x[THETA]
-        << " rad, cos(theta) = " << std::cos(x[THETA])
-        << " (gimbal lock at cos(theta) = 0, or a principal moment of inertia 0)";
+  if (body.hasFreeRoot() && !(std::abs(std::cos(x[THETA])) >= kGimbalLockCosine))
+    why << "its Euler angles are at gimbal lock: pitch theta = " << x[THETA] << " rad, cos(theta) = "
+        << std::cos(x[THETA])
+        << ", below 4 DBL_EPSILON = 8.9e-16 (the chart (phi, theta, psi) is singular there: the rates of phi and psi "
+           "are not defined)";
+  else if (body.hasFreeRoot() && coordinate < 3)
+    why << "its free root's rotation moves no inertia about the fixed axis " << "xyz"[coordinate]
+        << " (a principal moment of inertia 0)";
   else if (body.hasFreeRoot() && coordinate < 6)
     why << "its free root moves no mass (coordinate x[" << coordinate << "])";
   else
@@ -120,7 +125,6 @@ void SceneQueries::inverseDynamics(const SceneState& current, const std::vector<
   answer.dtau_dq.resize(derivatives ? K * layout.per_m : 0);
   answer.dtau_dqdot.resize(derivatives ? K * layout.per_m : 0);
   answer.cos_theta.resize(K * n);
-  const Vector3<double> no_gravity = Vector3<double>::Zero();
   for (std::size_t k = 0; k < K; ++k)
     for (std::size_t i = 0; i < n; ++i)
     {
@@ -129,11 +133,8 @@ void SceneQueries::inverseDynamics(const SceneState& current, const std::vector<
       const std::size_t v = k * layout.D + layout.x_offset[i], m = k * layout.per_m + layout.m_offset[i];
       const double* x = q.empty() ? current[indices[i]].data() : q.data() + v;
       const double *xd = slice(qdot, v), *xdd = slice(qddot, v);
-      diff_rigid_body::inverseDynamics(body, ws, x, xd, static_cast<const double*>(nullptr), no_gravity,
-                                       answer.velocity_terms.data() + v);
-      inverseDynamicsFromKinematics(body, ws, static_cast<const double*>(nullptr), static_cast<const double*>(nullptr),
-                                    gravity_, answer.gravity_terms.data() + v, /*inertias_ready=*/true);
-      inverseDynamicsFromKinematics(body, ws, xd, xdd, gravity_, answer.tau.data() + v, /*inertias_ready=*/true);
+      inverseDynamicsTerms(body, ws, x, xd, xdd, gravity_, answer.tau.data() + v, answer.velocity_terms.data() + v,
+                           answer.gravity_terms.data() + v);
       if (matrices > 0)
       {
         inverseDynamicsDerivatives(body, ws, x, xd, xdd, gravity_, ws.derivative_x, ws.derivative_xd);

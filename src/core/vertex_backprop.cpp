@@ -5,6 +5,7 @@
 #include "diff_rigid_body/detail/backprop_sums.h"
 #include "diff_rigid_body/free_body/vertex_columns.h"
 #include "diff_rigid_body/kinematics.h"
+#include "diff_rigid_body/motion_coordinates.h"
 
 namespace diff_rigid_body
 {
@@ -73,6 +74,7 @@ void vertexBackprop(const BodyModel& model, BodyWorkspace<double>& ws, const std
     const auto& sums = ws.segment_sums[static_cast<std::size_t>(dof.segment)];
     gradient[dof.coordinate] += dof.multiplier * (ws.S[k].v.dot(sums.force) + ws.S[k].w.dot(sums.moment));
   }
+  forceToCoordinates(model, ws, gradient);  // dL/dx = A^T dL/dnu
 }
 
 }  // namespace diff_rigid_body

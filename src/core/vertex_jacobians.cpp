@@ -41,7 +41,8 @@ namespace
 constexpr double kInflation = 1.0 + 64 * std::numeric_limits<double>::epsilon();
 
 /// Segment s's written columns into ws.column_motion: (V_c, W_c) = sum m_k S_k
-/// over the dofs k on its path to the root, rows width apart.
+/// over the dofs k on its path to the root that drive nu_c, rows width apart;
+/// then a free root's three rotation columns times T (dp/dx = (dp/dnu) A).
 void prepareSegmentColumns(const BodyModel& model, BodyWorkspace<double>& ws, const JacobianColumns& columns,
                            std::size_t s)
 {
@@ -61,6 +62,17 @@ void prepareSegmentColumns(const BodyModel& model, BodyWorkspace<double>& ws, co
       rows[i * width + static_cast<std::size_t>(column)] += dof.multiplier * S.v[i];
       rows[(3 + i) * width + static_cast<std::size_t>(column)] += dof.multiplier * S.w[i];
     }
+  }
+  if (!model.hasFreeRoot())
+    return;
+  const Matrix3<double>& T = ws.chart.T;
+  const std::size_t c0 = static_cast<std::size_t>(columns.of_coordinate[0]);  // rotation columns are always written
+  for (int i = 0; i < 6; ++i)
+  {
+    double* row = rows + static_cast<std::size_t>(i) * width + c0;
+    const double along[3] = { row[0], row[1], row[2] };
+    for (int c = 0; c < 3; ++c)
+      row[c] = along[0] * T(0, c) + along[1] * T(1, c) + along[2] * T(2, c);
   }
 }
 
