@@ -163,8 +163,10 @@ void massMatrixDerivatives(const BodyModel& model, BodyWorkspace<Scalar>& ws, co
 
 /// The node's dM/dx at x (d^3 values, dM/dx_j row-major at j d^2): a free
 /// object by the closed form (free_body/mass_matrix.h), any other body by
-/// massMatrixDerivatives.
-void massMatrixDerivativesRowMajor(const BodyModel& model, BodyWorkspace<double>& ws, const double* x, double* dM);
+/// massMatrixDerivativesFromCrba, after crba at x unless `crba_done` (ws
+/// holds it already: massMatrices of x alone just ran).
+void massMatrixDerivativesRowMajor(const BodyModel& model, BodyWorkspace<double>& ws, const double* x, double* dM,
+                                   bool crba_done = false);
 
 extern template void massMatrixDerivatives<double>(const BodyModel&, BodyWorkspace<double>&, const double*, double*);
 

@@ -141,29 +141,27 @@ void inverseDynamics(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Sc
   forceToCoordinates(model, ws, tau);
 }
 
-/// tau, the velocity terms c = tau(x, x', 0) with gamma = 0 and the gravity
-/// terms g = tau(x, 0, 0) (d values each) from one kinematics: the node's
-/// inverse dynamics.
-template <typename Scalar>
-void inverseDynamicsTerms(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Scalar* x, const Scalar* xd,
-                          const Scalar* xdd, const Vector3<Scalar>& gravity, Scalar* tau, Scalar* velocity_terms,
-                          Scalar* gravity_terms)
+namespace detail
 {
-  forwardKinematics(model, ws, x);
-  detail::segmentInertias(model, ws);
-  const Scalar* none = nullptr;
-  const Scalar* nu = motionRates(model, ws, xd);
-  inverseDynamicsInMotion(model, ws, nu, motionAccelerations(model, ws, xd, none), Vector3<Scalar>::Zero().eval(),
-                          velocity_terms, true);
-  inverseDynamicsInMotion(model, ws, none, none, gravity, gravity_terms, true);
-  inverseDynamicsInMotion(model, ws, nu, motionAccelerations(model, ws, xd, xdd), gravity, tau, true);
-  for (Scalar* out : { tau, velocity_terms, gravity_terms })
-    forceToCoordinates(model, ws, out);
+/// g_nu = -sum m_k S_k . Ic_seg(k) (0, gamma) (at rest every segment
+/// accelerates by (0, -gamma): one product per dof, no pass) into `g`,
+/// from the composite inertias in ws.
+template <typename Scalar>
+void gravityTermsFromComposites(const BodyModel& model, const BodyWorkspace<Scalar>& ws,
+                                const Vector3<Scalar>& gravity, Scalar* g)
+{
+  Motion<Scalar> fall;
+  fall.v = -gravity;
+  std::fill(g, g + model.coordinates, Scalar(0));
+  for (std::size_t k = 0; k < model.dofs.size(); ++k)
+  {
+    const Dof& dof = model.dofs[k];
+    g[dof.coordinate] += Scalar(dof.multiplier) *
+                         spatial::power(ws.S[k], spatial::momentum(ws.composite[static_cast<std::size_t>(dof.segment)], fall));
+  }
 }
+}  // namespace detail
 
-extern template void inverseDynamicsTerms<double>(const BodyModel&, BodyWorkspace<double>&, const double*,
-                                                  const double*, const double*, const Vector3<double>&, double*,
-                                                  double*, double*);
 extern template void inverseDynamics<double>(const BodyModel&, BodyWorkspace<double>&, const double*,
                                              const double*, const double*, const Vector3<double>&, double*);
 

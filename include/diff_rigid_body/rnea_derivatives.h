@@ -236,6 +236,41 @@ void inverseDynamicsDerivatives(const BodyModel& model, BodyWorkspace<Scalar>& w
     detail::inverseDynamicsDerivativesToCoordinates(model, ws, xd, xdd, dtau_dx, dtau_dxd);
 }
 
+/// The node's inverse dynamics at (x, x', x'') from one kinematics: tau,
+/// the velocity terms c = tau(x, x', 0) with gamma = 0 and the gravity
+/// terms g = tau(x, 0, 0) (d values each), and, when `dtau_dx` is not null,
+/// dtau/dx and dtau/dx' (into dtau_dx, dtau_dxd). tau and its derivatives
+/// come from one Newton-Euler pass, c from a second (velocities only), g
+/// from the composite inertias.
+template <typename Scalar>
+void inverseDynamicsTerms(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Scalar* x, const Scalar* xd,
+                          const Scalar* xdd, const Vector3<Scalar>& gravity, Scalar* tau, Scalar* velocity_terms,
+                          Scalar* gravity_terms, typename BodyWorkspace<Scalar>::MatrixX* dtau_dx,
+                          typename BodyWorkspace<Scalar>::MatrixX* dtau_dxd)
+{
+  forwardKinematics(model, ws, x);
+  detail::compositeInertias(model, ws);
+  const Scalar* nu = motionRates(model, ws, xd);
+  const Scalar* nu_dot = motionAccelerations(model, ws, xd, xdd);
+  if (dtau_dx)
+  {
+    inverseDynamicsDerivativesInMotion(model, ws, nu, nu_dot, gravity, *dtau_dx, *dtau_dxd);
+    if (model.hasFreeRoot())
+      detail::inverseDynamicsDerivativesToCoordinates(model, ws, xd, xdd, *dtau_dx, *dtau_dxd);
+    std::copy(ws.tau.data(), ws.tau.data() + model.coordinates, tau);
+  }
+  else
+    inverseDynamicsInMotion(model, ws, nu, nu_dot, gravity, tau, /*inertias_ready=*/true);
+  detail::gravityTermsFromComposites(model, ws, gravity, gravity_terms);
+  inverseDynamicsInMotion(model, ws, nu, motionAccelerations(model, ws, xd, static_cast<const Scalar*>(nullptr)),
+                          Vector3<Scalar>::Zero().eval(), velocity_terms, /*inertias_ready=*/true);
+  for (Scalar* out : { tau, velocity_terms, gravity_terms })
+    forceToCoordinates(model, ws, out);
+}
+
+extern template void inverseDynamicsTerms<double>(const BodyModel&, BodyWorkspace<double>&, const double*,
+                                                  const double*, const double*, const Vector3<double>&, double*,
+                                                  double*, double*, Eigen::MatrixXd*, Eigen::MatrixXd*);
 extern template void inverseDynamicsDerivatives<double>(const BodyModel&, BodyWorkspace<double>&, const double*,
                                                         const double*, const double*, const Vector3<double>&,
                                                         Eigen::MatrixXd&, Eigen::MatrixXd&);

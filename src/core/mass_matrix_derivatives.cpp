@@ -6,11 +6,14 @@ namespace diff_rigid_body
 {
 template void massMatrixDerivatives<double>(const BodyModel&, BodyWorkspace<double>&, const double*, double*);
 
-void massMatrixDerivativesRowMajor(const BodyModel& model, BodyWorkspace<double>& ws, const double* x, double* dM)
+void massMatrixDerivativesRowMajor(const BodyModel& model, BodyWorkspace<double>& ws, const double* x, double* dM,
+                                   bool crba_done)
 {
   if (!model.isFreeObject())
   {
-    massMatrixDerivatives(model, ws, x, dM);
+    if (!crba_done)
+      crba(model, ws, x);
+    massMatrixDerivativesFromCrba(model, ws, dM);
     return;
   }
   const std::array<Matrix6<double>, 6> closed_form =

@@ -134,17 +134,14 @@ void SceneQueries::inverseDynamics(const SceneState& current, const std::vector<
       const double* x = q.empty() ? current[indices[i]].data() : q.data() + v;
       const double *xd = slice(qdot, v), *xdd = slice(qddot, v);
       inverseDynamicsTerms(body, ws, x, xd, xdd, gravity_, answer.tau.data() + v, answer.velocity_terms.data() + v,
-                           answer.gravity_terms.data() + v);
-      if (matrices > 0)
+                           answer.gravity_terms.data() + v, matrices > 0 ? &ws.derivative_x : nullptr,
+                           &ws.derivative_xd);
+      if (coriolis)
+        writeRowMajor(ws.derivative_xd, 0.5, answer.coriolis_matrices.data() + m);
+      if (derivatives)
       {
-        inverseDynamicsDerivatives(body, ws, x, xd, xdd, gravity_, ws.derivative_x, ws.derivative_xd);
-        if (coriolis)
-          writeRowMajor(ws.derivative_xd, 0.5, answer.coriolis_matrices.data() + m);
-        if (derivatives)
-        {
-          writeRowMajor(ws.derivative_x, 1.0, answer.dtau_dq.data() + m);
-          writeRowMajor(ws.derivative_xd, 1.0, answer.dtau_dqdot.data() + m);
-        }
+        writeRowMajor(ws.derivative_x, 1.0, answer.dtau_dq.data() + m);
+        writeRowMajor(ws.derivative_xd, 1.0, answer.dtau_dqdot.data() + m);
       }
       answer.cos_theta[k * n + i] = body.hasFreeRoot() ? std::cos(x[THETA]) : 1.0;
     }

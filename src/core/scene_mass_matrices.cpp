@@ -49,21 +49,29 @@ void SceneQueries::massMatrices(const SceneState& current, const std::vector<std
   result.cos_theta.resize(configurations * n);
   result.derivatives.resize(derivatives ? configurations * layout.per_dm : 0);
   // Body i's x: q + x_offset[i], D apart, or its current state; matrix (k, i)
-  // at k per_m + m_offset[i], cos_theta (k n + i).
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    const double* x = q.empty() ? current[indices[i]].data() : q.data() + layout.x_offset[i];
-    diff_rigid_body::massMatrices(scene_.bodies[indices[i]], workspace(indices[i]), x, configurations, layout.D,
-                                  layout.per_m, n, result.mass_matrices.data() + layout.m_offset[i],
-                                  result.cos_theta.data() + i);
-  }
-  if (derivatives)
+  // at k per_m + m_offset[i], cos_theta (k n + i). With derivatives, M and
+  // dM/dx of one configuration from one CRBA; without, each body's K
+  // configurations in one batch.
+  const auto bodyQ = [&](std::size_t k, std::size_t i) {
+    return q.empty() ? current[indices[i]].data() : q.data() + k * layout.D + layout.x_offset[i];
+  };
+  if (!derivatives)
+    for (std::size_t i = 0; i < n; ++i)
+      diff_rigid_body::massMatrices(scene_.bodies[indices[i]], workspace(indices[i]), bodyQ(0, i), configurations,
+                                    layout.D, layout.per_m, n, result.mass_matrices.data() + layout.m_offset[i],
+                                    result.cos_theta.data() + i);
+  else
     for (std::size_t k = 0; k < configurations; ++k)
       for (std::size_t i = 0; i < n; ++i)
       {
-        const double* x = q.empty() ? current[indices[i]].data() : q.data() + k * layout.D + layout.x_offset[i];
-        massMatrixDerivativesRowMajor(scene_.bodies[indices[i]], workspace(indices[i]), x,
-                                      result.derivatives.data() + k * layout.per_dm + layout.dm_offset[i]);
+        const BodyModel& body = scene_.bodies[indices[i]];
+        BodyWorkspace<double>& ws = workspace(indices[i]);
+        diff_rigid_body::massMatrices(body, ws, bodyQ(k, i), 1, layout.D, layout.per_m, n,
+                                      result.mass_matrices.data() + k * layout.per_m + layout.m_offset[i],
+                                      result.cos_theta.data() + k * n + i);
+        massMatrixDerivativesRowMajor(body, ws, bodyQ(k, i),
+                                      result.derivatives.data() + k * layout.per_dm + layout.dm_offset[i],
+                                      /*crba_done=*/true);
       }
   // Finite inputs can still overflow (e.g. an inertia near DBL_MAX): never
   // return a non-finite number silently.
