@@ -53,6 +53,8 @@ struct BodyWorkspace
     derivative_xd.resize(static_cast<Eigen::Index>(d), static_cast<Eigen::Index>(d));
     inverse_mass.resize(static_cast<Eigen::Index>(d), static_cast<Eigen::Index>(d));
     factor_rows.resize(static_cast<Eigen::Index>(d), static_cast<Eigen::Index>(d));
+    inverse_h.resize(static_cast<Eigen::Index>(d), static_cast<Eigen::Index>(d));
+    product.resize(static_cast<Eigen::Index>(d), static_cast<Eigen::Index>(d));
     solution.resize(static_cast<Eigen::Index>(d));
     segment_sums.resize(n);
     column_motion.assign(6 * d, 0.0);
@@ -121,6 +123,8 @@ struct BodyWorkspace
   // ---- forward_dynamics.h ----
   MatrixX factor;       ///< d x d: H's factorization (tree_factorization.h)
   MatrixX factor_rows;  ///< d x d: scratch of solveMassMatrixColumns
+  MatrixX inverse_h;    ///< d x d: H^-1
+  MatrixX product;      ///< d x d: scratch of a product
   VectorX solution;  ///< d
   /// d x d each: d(tau or x'')/dx, d(tau or x'')/dx', M^-1, for the node's answers.
   MatrixX derivative_x, derivative_xd, inverse_mass;

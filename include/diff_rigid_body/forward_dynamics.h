@@ -10,7 +10,9 @@
 // carries 1 / cos(theta), once.
 //
 // Derivatives, with D_q, D_nu those of inverse dynamics in nu at
-// (nu, nu') (rnea_derivatives.h) and dA_c = dA/dx_c:
+// (nu, nu') (rnea_derivatives.h, from the same kinematics and composite
+// inertias) and dA_c = dA/dx_c; H^-1 once from the factorization (d tree
+// solves), then two products with it:
 //   dnu'/dx_c = -H^-1 (D_q A e_c + D_nu dA_c x' + A^-T dA_c^T A^-T tau)
 //   dx''/dx_c = A^-1 (dnu'/dx_c - dQ/dx_c - dA_c x'')
 //   dx''/dx'  = A^-1 (-H^-1 D_nu A - dQ/dx')
@@ -137,17 +139,21 @@ void forwardDerivativesAfterSolve(const BodyModel& model, const BodyWorkspace<Sc
 }  // namespace detail
 
 /// M^-1 = A^-1 H^-1 A^-T into `inverse_mass` (d x d) from the kinematics
-/// and H's factorization in ws (forwardDynamics first).
+/// and H's factorization in ws (forwardDynamics first); H^-1 stays in
+/// ws.inverse_h.
 template <typename Scalar>
 void inverseMassMatrix(const BodyModel& model, BodyWorkspace<Scalar>& ws,
                        typename BodyWorkspace<Scalar>::MatrixX& inverse_mass)
 {
   const Eigen::Index d = static_cast<Eigen::Index>(model.coordinates);
-  inverse_mass.setIdentity(d, d);
-  detail::rotationRowsToMotion(model, ws, inverse_mass);
-  solveMassMatrixColumns(model, ws, inverse_mass);
-  if (model.hasFreeRoot())
-    mapRotationRows(model, ws.chart.inverse(), inverse_mass);
+  ws.inverse_h.setIdentity(d, d);
+  solveMassMatrixColumns(model, ws, ws.inverse_h);
+  inverse_mass = ws.inverse_h;
+  if (!model.hasFreeRoot())
+    return;
+  const Matrix3<Scalar> inverse = ws.chart.inverse();
+  mapRotationRows(model, inverse, inverse_mass);
+  mapRotationColumns(model, Matrix3<Scalar>(inverse.transpose()), inverse_mass);
 }
 
 /// x'' (into `xdd`) and dx''/dx, dx''/dx', dx''/dtau = M^-1 (d x d each,
@@ -169,13 +175,13 @@ int forwardDynamicsDerivatives(const BodyModel& model, BodyWorkspace<Scalar>& ws
   inverseDynamicsDerivativesInMotion(model, ws, nu, nu_dot, gravity, dxdd_dx, dxdd_dxd);
   if (model.hasFreeRoot())
     detail::forwardDerivativesBeforeSolve(model, ws, xd, dxdd_dx, dxdd_dxd);
-  solveMassMatrixColumns(model, ws, dxdd_dx);
-  solveMassMatrixColumns(model, ws, dxdd_dxd);
-  dxdd_dx = -dxdd_dx;
-  dxdd_dxd = -dxdd_dxd;
+  inverseMassMatrix(model, ws, inverse_mass);  // H^-1 once, then two products
+  ws.product.noalias() = -ws.inverse_h * dxdd_dx;
+  dxdd_dx.swap(ws.product);
+  ws.product.noalias() = -ws.inverse_h * dxdd_dxd;
+  dxdd_dxd.swap(ws.product);
   if (model.hasFreeRoot())
     detail::forwardDerivativesAfterSolve(model, ws, xd, xdd, dxdd_dx, dxdd_dxd);
-  inverseMassMatrix(model, ws, inverse_mass);
   return -1;
 }
 

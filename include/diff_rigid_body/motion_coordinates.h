@@ -55,21 +55,28 @@ void forceToCoordinates(const BodyModel& model, const BodyWorkspace<Scalar>& ws,
   rotation = (ws.chart.T.transpose() * rotation).eval();
 }
 
-/// m times A from the right: its first three columns (directions in nu)
-/// turned into the rotation coordinates' (free root only). Row by row, in
-/// fixed-size pieces: nothing is allocated.
+/// m's first three columns times `right` (3 x 3): A with right = T, A^-T
+/// with T^-T (free root only). Row by row, in fixed-size pieces: nothing is
+/// allocated.
 template <typename Scalar, typename Matrix>
-void columnsToCoordinates(const BodyModel& model, const BodyWorkspace<Scalar>& ws, Matrix& m)
+void mapRotationColumns(const BodyModel& model, const Matrix3<Scalar>& right, Matrix& m)
 {
   if (!model.hasFreeRoot())
     return;
-  const Matrix3<Scalar>& T = ws.chart.T;
   for (Eigen::Index i = 0; i < m.rows(); ++i)
   {
     const Eigen::Matrix<Scalar, 1, 3> row(m(i, 0), m(i, 1), m(i, 2));
     for (int c = 0; c < 3; ++c)
-      m(i, c) = row[0] * T(0, c) + row[1] * T(1, c) + row[2] * T(2, c);
+      m(i, c) = row[0] * right(0, c) + row[1] * right(1, c) + row[2] * right(2, c);
   }
+}
+
+/// m times A from the right: its first three columns (directions in nu)
+/// turned into the rotation coordinates' (free root only).
+template <typename Scalar, typename Matrix>
+void columnsToCoordinates(const BodyModel& model, const BodyWorkspace<Scalar>& ws, Matrix& m)
+{
+  mapRotationColumns(model, ws.chart.T, m);
 }
 
 /// m (rows in nu) times `left` (3 x 3) on its first three rows: A^T with

@@ -100,27 +100,41 @@ void solveMassMatrix(const BodyModel& model, BodyWorkspace<Scalar>& ws, Scalar* 
 /// Solves H Y = B in place for every column of B (d x n, nu order in rows),
 /// with the factorization in ws: the same walks as solveMassMatrix, each
 /// step a whole row of B at once (ws.factor_rows is the scratch, factor
-/// rows as its columns, so every update is contiguous).
+/// rows as its columns, so every update is contiguous). n <= d.
 template <typename Scalar>
 void solveMassMatrixColumns(const BodyModel& model, BodyWorkspace<Scalar>& ws,
                             typename BodyWorkspace<Scalar>::MatrixX& B)
 {
   const int d = static_cast<int>(model.coordinates);
   const auto& H = ws.factor;
-  auto& Y = ws.factor_rows;  // column k = row k of the system in factorization order
+  // Column k = row k of the system in factorization order, in ws.factor_rows'
+  // storage (nothing is allocated).
+  Eigen::Map<typename BodyWorkspace<Scalar>::MatrixX> Y(ws.factor_rows.data(), B.cols(), d);
   const auto parent = [&](int k) { return model.factor_parent[static_cast<std::size_t>(k)]; };
   const auto coordinate = [&](int k) { return static_cast<Eigen::Index>(model.factor_coordinate[static_cast<std::size_t>(k)]); };
-  Y.resize(B.cols(), d);
   for (int k = 0; k < d; ++k)
     Y.col(k) = B.row(coordinate(k)).transpose();
+  const Eigen::Index n = Y.rows();
+  Scalar* const rows = Y.data();
+  const auto axpy = [&](int target, const Scalar& a, int source) {  // row target -= a row source
+    Scalar* __restrict__ y = rows + target * n;
+    const Scalar* __restrict__ x = rows + source * n;
+    for (Eigen::Index i = 0; i < n; ++i)
+      y[i] -= a * x[i];
+  };
   for (int k = d - 1; k >= 0; --k)  // L^T Z = B
     for (int j = parent(k); j >= 0; j = parent(j))
-      Y.col(j) -= H(k, j) * Y.col(k);
+      axpy(j, H(k, j), k);
   for (int k = 0; k < d; ++k)  // D W = Z
-    Y.col(k) /= H(k, k);
+  {
+    const Scalar pivot = H(k, k);
+    Scalar* y = rows + k * n;
+    for (Eigen::Index i = 0; i < n; ++i)
+      y[i] /= pivot;
+  }
   for (int k = 0; k < d; ++k)  // L Y = W
     for (int j = parent(k); j >= 0; j = parent(j))
-      Y.col(k) -= H(k, j) * Y.col(j);
+      axpy(k, H(k, j), j);
   for (int k = 0; k < d; ++k)
     B.row(coordinate(k)) = Y.col(k).transpose();
 }
