@@ -64,6 +64,18 @@ enum class JointType : std::uint8_t
   Prismatic,  ///< translation along the axis [m]
 };
 
+/// The kernels a body's algorithms take, chosen once by the model builder
+/// (body_builder.cpp). A body of one free segment (a version-1 free object)
+/// has closed forms (free_body/: pose, M and dM/dx batched, J and backprop
+/// by SIMD kernels) that give the tree's answers to rounding, faster; every
+/// other body takes the tree's (one-segment kernels inside them are the
+/// same for every segment).
+enum class BodyKernels : std::uint8_t
+{
+  Tree,
+  FreeSegment,
+};
+
 /// One 1-dof motion of the tree (see the header comment).
 struct Dof
 {
@@ -169,11 +181,11 @@ struct BodyModel
   std::vector<double> joint_upper;
   /// x at load: the free root's pose from the URDF joint origins, every joint at 0.
   Eigen::VectorXd initial_x;
+  BodyKernels kernels = BodyKernels::Tree;  ///< set by the builder
 
   bool hasFreeRoot() const { return segments.front().joint_type == JointType::Free; }
-  /// A free object: a free root and nothing below it. Its algorithms take
-  /// the closed forms of one free body (free_body/).
-  bool isFreeObject() const { return hasFreeRoot() && segments.size() == 1; }
+  /// Whether the algorithms take the closed forms of one free segment (kernels).
+  bool closedFormKernels() const { return kernels == BodyKernels::FreeSegment; }
   /// Coordinates of the root: 6 for a free root, else 0.
   std::size_t rootCoordinates() const { return hasFreeRoot() ? 6 : 0; }
   std::size_t vertexCount() const { return static_cast<std::size_t>(vertices.cols()); }

@@ -263,7 +263,7 @@ private:
                    std::vector<Out>& jacobians) const;
   /// Refuses a get_mass_matrix answer over the budget of doubles.
   void checkMassMatrixBudget(std::size_t configurations, std::size_t bodies, std::size_t per_configuration,
-                             bool all_free, bool derivatives, std::size_t q_size) const;
+                             bool all_six, bool derivatives, std::size_t q_size) const;
 
   Scene scene_;
   Eigen::Vector3d gravity_;

@@ -23,9 +23,11 @@
 namespace diff_rigid_body
 {
 /// dL/dx at x (d values into `gradient`) for `gradients` (3 per vertex of
-/// `vertices`, empty = all, in order; indices already checked). Nothing is
+/// `vertices`, empty = all, in order; indices already checked). Returns
+/// false, with no answer, where the kinematics at x overflow (a prismatic
+/// joint at 1e308); the closed form of a free segment cannot. Nothing is
 /// allocated.
-void vertexBackprop(const BodyModel& model, BodyWorkspace<double>& ws, const std::vector<std::uint32_t>& vertices,
+bool vertexBackprop(const BodyModel& model, BodyWorkspace<double>& ws, const std::vector<std::uint32_t>& vertices,
                     const double* gradients, const double* x, double* gradient);
 
 }  // namespace diff_rigid_body

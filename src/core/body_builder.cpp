@@ -180,6 +180,7 @@ BodyModel buildBodyModel(const UrdfDescription& description, const LinkTree& tre
   buildDofs(assignCoordinates(description, body, context), body);
   if (!free_object)
     warnIfCoordinatesMoveNoMass(body, context);
+  body.kernels = free_object ? BodyKernels::FreeSegment : BodyKernels::Tree;
   setInitialState(description, tree, fixed_from_root, body, context);
   return body;
 }

@@ -45,7 +45,7 @@ void massMatrices(const BodyModel& model, BodyWorkspace<double>& ws, const doubl
                   std::size_t stride, std::size_t m_stride, std::size_t cos_stride, double* mass_matrices,
                   double* cos_theta)
 {
-  if (model.isFreeObject())
+  if (model.closedFormKernels())
   {
     freeObjectMassMatrices(model.segments[0], x, count, stride, m_stride, cos_stride, mass_matrices, cos_theta);
     return;

@@ -19,7 +19,7 @@ void linkPoses(const BodyModel& model, BodyWorkspace<double>& ws, const double* 
                std::vector<Eigen::Isometry3d>& poses)
 {
   poses.resize(model.links.size());
-  if (model.isFreeObject())
+  if (model.closedFormKernels())
   {
     const BodyPose<double> pose{ Eigen::Map<const Vector6<double>>(x) };
     ws.R[0] = pose.R;

@@ -9,7 +9,7 @@ template void massMatrixDerivatives<double>(const BodyModel&, BodyWorkspace<doub
 void massMatrixDerivativesRowMajor(const BodyModel& model, BodyWorkspace<double>& ws, const double* x, double* dM,
                                    bool crba_done)
 {
-  if (!model.isFreeObject())
+  if (!model.closedFormKernels())
   {
     if (!crba_done)
       crba(model, ws, x);

@@ -18,7 +18,7 @@ struct RequestLayout
 {
   std::vector<std::size_t> x_offset, m_offset, dm_offset;
   std::size_t D = 0, per_m = 0, per_dm = 0;
-  bool all_free = true;  ///< every listed body is a free object (version 1's messages)
+  bool all_six = true;  ///< every listed body has 6 coordinates (version 1's messages, in matrices)
 };
 
 /// The layout of a request for the bodies `indices`, in this thread's reused buffers.
@@ -29,7 +29,7 @@ inline const RequestLayout& requestLayout(const SceneQueries& queries, const std
   layout.m_offset.clear();
   layout.dm_offset.clear();
   layout.D = layout.per_m = layout.per_dm = 0;
-  layout.all_free = true;
+  layout.all_six = true;
   for (std::size_t index : indices)
   {
     const std::size_t d = queries.dofs(index);
@@ -39,7 +39,7 @@ inline const RequestLayout& requestLayout(const SceneQueries& queries, const std
     layout.D += d;
     layout.per_m += d * d;
     layout.per_dm += d * d * d;
-    layout.all_free = layout.all_free && queries.body(index).isFreeObject();
+    layout.all_six = layout.all_six && d == 6;
   }
   return layout;
 }

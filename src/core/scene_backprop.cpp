@@ -39,9 +39,8 @@ void SceneQueries::backpropConfigurations(const SceneState& current, const std::
   answer.resize(d * configurations);
   for (std::size_t k = 0; k < configurations; ++k)
   {
-    vertexBackprop(body, ws, vertices, gradients.data() + 3 * count * k, configurationQ(current, index, q, k),
-                   answer.data() + d * k);
-    if (!body.isFreeObject() && !kinematicsAreFinite(body, ws))
+    if (!vertexBackprop(body, ws, vertices, gradients.data() + 3 * count * k, configurationQ(current, index, q, k),
+                        answer.data() + d * k))
     {
       gradient.clear();
       reject((configurations > 1 ? "q (configuration " + std::to_string(k) + ")" : std::string("q")) +

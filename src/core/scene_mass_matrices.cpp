@@ -27,7 +27,7 @@ void SceneQueries::massMatrices(const SceneState& current, const std::vector<std
   {
     if (n == 0 || q.size() % layout.D != 0)
       reject(sizeMismatch("q",
-                          layout.all_free ? "a multiple of 6 x " + std::to_string(n) +
+                          layout.all_six ? "a multiple of 6 x " + std::to_string(n) +
                                                 " bodies (or empty for the current state)" :
                                             "a multiple of " + std::to_string(layout.D) + " values (the sum of the " +
                                                 std::to_string(n) + " bodies' dofs), or empty for the current state",
@@ -35,7 +35,7 @@ void SceneQueries::massMatrices(const SceneState& current, const std::vector<std
     configurations = q.size() / layout.D;
     requireFinite(q.data(), q.size(), "q");
   }
-  checkMassMatrixBudget(configurations, n, layout.per_m + (derivatives ? layout.per_dm : 0), layout.all_free,
+  checkMassMatrixBudget(configurations, n, layout.per_m + (derivatives ? layout.per_dm : 0), layout.all_six,
                         derivatives, q.size());
   MassMatrixAnswer result = std::move(answer);
   result.bodies.resize(n);
@@ -89,7 +89,7 @@ MassMatrixAnswer SceneQueries::massMatrices(const SceneState& current, const std
 }
 
 void SceneQueries::checkMassMatrixBudget(std::size_t configurations, std::size_t bodies, std::size_t per_configuration,
-                                         bool all_free, bool derivatives, std::size_t q_size) const
+                                         bool all_six, bool derivatives, std::size_t q_size) const
 {
   // For 6-dof bodies per_configuration = 36 n (252 n with derivatives), so
   // this is "configurations x bodies <= kMaxMassMatrices(WithDerivatives)".
@@ -97,7 +97,7 @@ void SceneQueries::checkMassMatrixBudget(std::size_t configurations, std::size_t
       derivatives ? RequestLimits::kMaxMassMatrixDoublesWithDerivatives : RequestLimits::kMaxMassMatrixDoubles;
   if (per_configuration == 0 || configurations <= budget / per_configuration)
     return;
-  if (all_free)
+  if (all_six)
   {
     const std::size_t limit =
         derivatives ? RequestLimits::kMaxMassMatricesWithDerivatives : RequestLimits::kMaxMassMatrices;

@@ -19,13 +19,10 @@ using detail::sizeMismatch;
 namespace
 {
 /// Refuses an x whose link poses overflow (a prismatic joint at 1e308,
-/// say): tf would otherwise publish inf. A free object's pose is its q,
-/// already checked finite.
+/// say): tf would otherwise publish inf.
 void requireFinitePoses(const BodyModel& body, BodyWorkspace<double>& ws, const Eigen::VectorXd& x,
                         const std::string& field)
 {
-  if (body.isFreeObject())
-    return;
   forwardKinematics(body, ws, x.data());
   if (!kinematicsAreFinite(body, ws))
     reject(field + ": the link poses of body '" + body.name + "' overflow at these values");

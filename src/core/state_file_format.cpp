@@ -122,15 +122,17 @@ std::uint64_t sceneFingerprint(const Scene& scene)
   hash.number(static_cast<std::uint64_t>(scene.bodies.size()));
   for (const BodyModel& body : scene.bodies)
   {
-    // A free object hashes as version 1 did: name, mass, inertia, COM offset, vertices.
+    // A body of one free segment hashes as version 1 did (its files stay
+    // valid): name, mass, inertia, COM offset, vertices; a tree adds its
+    // segments, joints and coordinates instead of the vertices.
     hash.text(body.name);
-    hash.number(body.isFreeObject() ? body.segments[0].inertia.mass : body.mass());
+    hash.number(body.mass());
     for (int i = 0; i < 9; ++i)
       hash.number(body.segments[0].inertia.inertia(i / 3, i % 3));
     const Eigen::Vector3d com_offset = body.rootComOffset();
     for (int i = 0; i < 3; ++i)
       hash.number(com_offset[i]);
-    if (!body.isFreeObject())
+    if (body.segments.size() > 1 || !body.hasFreeRoot())
     {
       hashTree(body, hash);
       continue;

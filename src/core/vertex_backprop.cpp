@@ -41,17 +41,19 @@ void segmentGradientSums(const BodyModel& model, BodyWorkspace<double>& ws,
 }
 }  // namespace
 
-void vertexBackprop(const BodyModel& model, BodyWorkspace<double>& ws, const std::vector<std::uint32_t>& vertices,
+bool vertexBackprop(const BodyModel& model, BodyWorkspace<double>& ws, const std::vector<std::uint32_t>& vertices,
                     const double* gradients, const double* x, double* gradient)
 {
-  if (model.isFreeObject())
+  if (model.closedFormKernels())
   {
     const BodyPose<double> pose{ Eigen::Map<const Vector6<double>>(x) };
     const Vector6<double> dL_dq = backpropagateVertexGradients(pose, model.vertex_columns, vertices, gradients);
     std::copy(dL_dq.data(), dL_dq.data() + 6, gradient);
-    return;
+    return true;
   }
   forwardKinematics(model, ws, x);
+  if (!kinematicsAreFinite(model, ws))
+    return false;
   segmentGradientSums(model, ws, vertices, gradients);
   const std::size_t n = model.segments.size();
   for (std::size_t s = 0; s < n; ++s)
@@ -75,6 +77,7 @@ void vertexBackprop(const BodyModel& model, BodyWorkspace<double>& ws, const std
     gradient[dof.coordinate] += dof.multiplier * (ws.S[k].v.dot(sums.force) + ws.S[k].w.dot(sums.moment));
   }
   forceToCoordinates(model, ws, gradient);  // dL/dx = A^T dL/dnu
+  return true;
 }
 
 }  // namespace diff_rigid_body

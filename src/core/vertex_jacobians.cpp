@@ -148,17 +148,16 @@ void segmentVertices(const SegmentMotion& motion, std::size_t runtime_width, con
 #undef DRB_SEGMENT_VERTICES_BODY
 
 #if defined(DRB_VERTEX_KERNELS_AVX2)
-/// The same in double with AVX2 + FMA, four columns per register (the last
-/// up to three through a mask): J row x = V_x + d_z W_y - d_y W_z, etc.
+/// The same in double with AVX2 + FMA, four columns per register, then two
+/// (SSE registers) and one (scalar): masked AVX stores are slow on some
+/// CPUs. J row x = V_x + d_z W_y - d_y W_z, etc.
 __attribute__((target("avx2,fma"))) void segmentVerticesAvx2(const SegmentMotion& motion, std::size_t width,
                                                               const double* __restrict__ vertices, std::size_t count,
                                                               double* __restrict__ P, double* __restrict__ J)
 {
   const double* V = motion.V;
   const double* R = motion.R;
-  const std::size_t full = width & ~std::size_t(3);
-  const long long rest = static_cast<long long>(width - full);
-  const __m256i mask = _mm256_setr_epi64x(rest > 0 ? -1 : 0, rest > 1 ? -1 : 0, rest > 2 ? -1 : 0, 0);
+  const std::size_t full = width & ~std::size_t(3), pair = width & ~std::size_t(1);
   for (std::size_t n = 0; n < count; ++n)
   {
     const double* p0 = vertices + 3 * n;
@@ -171,29 +170,30 @@ __attribute__((target("avx2,fma"))) void segmentVerticesAvx2(const SegmentMotion
     }
     if (!J)
       continue;
-    const __m256d dx = _mm256_set1_pd(d[0]), dy = _mm256_set1_pd(d[1]), dz = _mm256_set1_pd(d[2]);
     double* Jn = J + 3 * width * n;
-#define DRB_JACOBIAN_ROWS(LOAD, STORE)                                                                              \
+#define DRB_JACOBIAN_ROWS(VEC, SET1, LOAD, STORE, FMADD, FNMADD)                                                   \
   {                                                                                                                \
-    const __m256d Wx = LOAD(V + 3 * width + c), Wy = LOAD(V + 4 * width + c), Wz = LOAD(V + 5 * width + c);       \
-    STORE(Jn + c, _mm256_fmadd_pd(dz, Wy, _mm256_fnmadd_pd(dy, Wz, LOAD(V + c))));                                 \
-    STORE(Jn + width + c, _mm256_fmadd_pd(dx, Wz, _mm256_fnmadd_pd(dz, Wx, LOAD(V + width + c))));                 \
-    STORE(Jn + 2 * width + c, _mm256_fmadd_pd(dy, Wx, _mm256_fnmadd_pd(dx, Wy, LOAD(V + 2 * width + c))));         \
+    const VEC dx = SET1(d[0]), dy = SET1(d[1]), dz = SET1(d[2]);                                                   \
+    const VEC Wx = LOAD(V + 3 * width + c), Wy = LOAD(V + 4 * width + c), Wz = LOAD(V + 5 * width + c);            \
+    STORE(Jn + c, FMADD(dz, Wy, FNMADD(dy, Wz, LOAD(V + c))));                                                     \
+    STORE(Jn + width + c, FMADD(dx, Wz, FNMADD(dz, Wx, LOAD(V + width + c))));                                     \
+    STORE(Jn + 2 * width + c, FMADD(dy, Wx, FNMADD(dx, Wy, LOAD(V + 2 * width + c))));                             \
   }
-#define DRB_LOAD_ALL(a) _mm256_loadu_pd(a)
-#define DRB_STORE_ALL(a, v) _mm256_storeu_pd(a, v)
-#define DRB_LOAD_MASKED(a) _mm256_maskload_pd(a, mask)
-#define DRB_STORE_MASKED(a, v) _mm256_maskstore_pd(a, mask, v)
     std::size_t c = 0;
     for (; c < full; c += 4)
-      DRB_JACOBIAN_ROWS(DRB_LOAD_ALL, DRB_STORE_ALL)
-    if (rest > 0)
-      DRB_JACOBIAN_ROWS(DRB_LOAD_MASKED, DRB_STORE_MASKED)
+      DRB_JACOBIAN_ROWS(__m256d, _mm256_set1_pd, _mm256_loadu_pd, _mm256_storeu_pd, _mm256_fmadd_pd, _mm256_fnmadd_pd)
+    if (c < pair)
+    {
+      DRB_JACOBIAN_ROWS(__m128d, _mm_set1_pd, _mm_loadu_pd, _mm_storeu_pd, _mm_fmadd_pd, _mm_fnmadd_pd)
+      c += 2;
+    }
 #undef DRB_JACOBIAN_ROWS
-#undef DRB_LOAD_ALL
-#undef DRB_STORE_ALL
-#undef DRB_LOAD_MASKED
-#undef DRB_STORE_MASKED
+    if (c < width)  // the same with one fused multiply-add per term, as the lanes above
+    {
+      Jn[c] = std::fma(d[2], V[4 * width + c], std::fma(-d[1], V[5 * width + c], V[c]));
+      Jn[width + c] = std::fma(d[0], V[5 * width + c], std::fma(-d[2], V[3 * width + c], V[width + c]));
+      Jn[2 * width + c] = std::fma(d[1], V[3 * width + c], std::fma(-d[0], V[4 * width + c], V[2 * width + c]));
+    }
   }
 }
 #endif
@@ -247,7 +247,7 @@ void freeObjectVertexJacobians(const BodyModel& model, const JacobianColumns& co
 double vertexOutputBound(const BodyModel& model, BodyWorkspace<double>& ws, const JacobianColumns& columns,
                          const std::vector<std::uint32_t>& vertices, const double* x)
 {
-  if (model.isFreeObject())
+  if (model.closedFormKernels())
     return std::max({ std::abs(x[TX]), std::abs(x[TY]), std::abs(x[TZ]) }) +
            kInflation * model.segments[0].vertex_radius;
   forwardKinematics(model, ws, x);
@@ -270,7 +270,7 @@ template <typename Out>
 void vertexJacobians(const BodyModel& model, BodyWorkspace<double>& ws, const JacobianColumns& columns,
                      const std::vector<std::uint32_t>& vertices, const double* x, Out* positions, Out* jacobians)
 {
-  if (model.isFreeObject())
+  if (model.closedFormKernels())
   {
     freeObjectVertexJacobians(model, columns, vertices, x, positions, jacobians);
     return;

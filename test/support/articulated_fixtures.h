@@ -170,7 +170,7 @@ inline std::vector<std::pair<std::string, Eigen::VectorXd>> configurations(const
 inline const diff_rigid_body::BodyModel& bodyRootedAt(const diff_rigid_body::Scene& scene, const std::string& root)
 {
   for (const auto& body : scene.bodies)
-    if (!body.isFreeObject() && body.segments.front().link == root)
+    if (!body.closedFormKernels() && body.segments.front().link == root)
       return body;
   throw std::runtime_error("no articulated body rooted at " + root);
 }

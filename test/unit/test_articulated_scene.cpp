@@ -52,7 +52,7 @@ TEST(ArticulatedScene, TwoLinkArmMatchesTheClosedForm)
                                             "<origin xyz=\"" + std::to_string(l1) + " 0 0\"/>", "0 0 1"));
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
   ASSERT_EQ(scene.bodies.size(), 1u);
-  ASSERT_FALSE(scene.bodies[0].isFreeObject());
+  ASSERT_FALSE(scene.bodies[0].closedFormKernels());
   const drb::BodyModel& arm = scene.bodies[0];
   ASSERT_EQ(arm.coordinates, 2u);
   for (const double x2 : { 0.0, 0.7, -1.4, 2.0 })
@@ -82,7 +82,7 @@ TEST(ArticulatedScene, FixedBaseTreeHasItsJointsInDocumentOrderWithLimits)
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
   ASSERT_EQ(scene.bodies.size(), 1u);
   const drb::BodyModel& body = scene.bodies[0];
-  ASSERT_FALSE(body.isFreeObject());
+  ASSERT_FALSE(body.closedFormKernels());
   const drb::BodyModel& tree = body;
   EXPECT_EQ(body.name, "base");
   EXPECT_FALSE(tree.hasFreeRoot());
@@ -152,7 +152,7 @@ TEST(ArticulatedScene, FloatingRootCarriesItsJointsAndAFloatingJointBelowStartsA
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
   ASSERT_EQ(scene.bodies.size(), 2u);
   const drb::BodyModel& torso = scene.bodies[0];
-  ASSERT_FALSE(torso.isFreeObject());
+  ASSERT_FALSE(torso.closedFormKernels());
   EXPECT_TRUE(torso.hasFreeRoot());
   EXPECT_EQ(torso.coordinates, 7u);
   EXPECT_NEAR(torso.initial_x[0], 0.1, 1e-15);
@@ -160,7 +160,7 @@ TEST(ArticulatedScene, FloatingRootCarriesItsJointsAndAFloatingJointBelowStartsA
   EXPECT_NEAR(torso.initial_x[2], 0.3, 1e-15);
   EXPECT_EQ(torso.initial_x[6], 0.0);
   EXPECT_EQ(scene.bodies[1].name, "ball");
-  EXPECT_TRUE(scene.bodies[1].isFreeObject()) << "a floating body without joints is a version-1 free body";
+  EXPECT_TRUE(scene.bodies[1].closedFormKernels()) << "a floating body without joints is a version-1 free body";
 }
 
 TEST(ArticulatedScene, PlanarJointMakesAFreeBodyWithANote)
@@ -168,7 +168,7 @@ TEST(ArticulatedScene, PlanarJointMakesAFreeBodyWithANote)
   const std::string xml = robot(rodLink("puck", 1, 0, 0.1) + oneDofJoint("slide", "planar", "world", "puck", "", "0 0 1"));
   const drb::Scene scene = drb::loadSceneFromUrdf(xml);
   ASSERT_EQ(scene.bodies.size(), 1u);
-  EXPECT_TRUE(scene.bodies[0].isFreeObject());
+  EXPECT_TRUE(scene.bodies[0].closedFormKernels());
   ASSERT_EQ(scene.unmodelled_joints.size(), 1u);
   EXPECT_NE(scene.unmodelled_joints[0].find("'slide' (planar)"), std::string::npos) << scene.unmodelled_joints[0];
 }
@@ -183,7 +183,7 @@ TEST(ArticulatedScene, FreeObjectsLoadAsInVersionOne)
   ASSERT_EQ(model.bodies.size(), v1.bodies.size());
   for (std::size_t i = 0; i < v1.bodies.size(); ++i)
   {
-    EXPECT_TRUE(model.bodies[i].isFreeObject());
+    EXPECT_TRUE(model.bodies[i].closedFormKernels());
     EXPECT_EQ(model.bodies[i].initial_x, v1.bodies[i].initial_x);
     EXPECT_EQ(model.bodies[i].vertices, v1.bodies[i].vertices);
     EXPECT_EQ(model.bodies[i].segments[0].inertia.inertia, v1.bodies[i].segments[0].inertia.inertia);
