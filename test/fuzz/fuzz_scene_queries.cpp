@@ -1,12 +1,15 @@
 // libFuzzer target: the decoding and validation of every service request,
-// on SceneQueries over a small fixed scene (two bodies from primitives, one
-// with a merged link; no files are read).
+// on SceneQueries over a small fixed scene (fuzz_scene_inputs.h: a free
+// object, a fixed-base body and a floating tree; no files are read).
 //
 // The input is decoded with FuzzedDataProvider into up to 8 requests, each
 // one of set_state, get_state, get_mass_matrix, get_vertex_jacobians, its
-// compact variant (double and float32) and backprop (K = 1 to 3 configurations), with fuzzed body names (known, unknown, empty, repeated, random
-// bytes), q and gradients (any double: NaN, +-Inf, subnormals, +-0, huge,
-// or plain values), vertex indices (in range or any uint32) and sizes.
+// compact variant (double and float32), backprop, inverse_dynamics and
+// forward_dynamics (fuzz_dynamics_requests.h) (K = 1 to 3 configurations),
+// with fuzzed body names (known, unknown, empty, repeated, random bytes), q,
+// rates, forces and gradients (any double: NaN, +-Inf, subnormals, +-0,
+// huge, +-pi/2, or plain values), vertex indices (in range or any uint32)
+// and sizes.
 // set_state changes the current state that later requests see, so queries
 // also run on extreme (finite) states.
 //
@@ -24,107 +27,21 @@
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include "diff_rigid_body/exceptions.h"
-#include "diff_rigid_body/scene_queries.h"
-#include "diff_rigid_body/urdf_scene.h"
+#include "fuzz_dynamics_requests.h"
 #include "fuzz_invariants.h"
+#include "fuzz_scene_inputs.h"
 
 namespace
 {
 namespace drb = diff_rigid_body;
+using drb_fuzz::fuzzedDouble;
+using drb_fuzz::fuzzedDoubles;
+using drb_fuzz::fuzzedName;
+using drb_fuzz::fuzzedNames;
+using drb_fuzz::fuzzedVertices;
+using drb_fuzz::queries;
 using drb_fuzz::require;
 using drb_fuzz::requireAllFinite;
-
-const char* const kUrdf =
-    "<robot name=\"fuzz\"><link name=\"world\"/>"
-    "<link name=\"cube\"><inertial><origin xyz=\"0.01 0.02 0.03\" rpy=\"0.1 0.2 0.3\"/><mass value=\"2\"/>"
-    "<inertia ixx=\"0.1\" iyy=\"0.2\" izz=\"0.25\" ixy=\"0.01\" ixz=\"0.02\" iyz=\"-0.03\"/></inertial>"
-    "<collision><geometry><box size=\"0.2 0.3 0.4\"/></geometry></collision></link>"
-    "<link name=\"cap\"><collision><origin xyz=\"0 0 0.1\"/><geometry><cylinder radius=\"0.05\" length=\"0.1\"/>"
-    "</geometry></collision></link>"
-    "<joint name=\"cap_joint\" type=\"fixed\"><parent link=\"cube\"/><child link=\"cap\"/>"
-    "<origin xyz=\"0 0 0.2\"/></joint>"
-    "<link name=\"ball\"><inertial><mass value=\"1\"/><inertia ixx=\"0.004\" iyy=\"0.004\" izz=\"0.004\" ixy=\"0\" "
-    "ixz=\"0\" iyz=\"0\"/></inertial><collision><geometry><sphere radius=\"0.1\"/></geometry></collision></link>"
-    "<joint name=\"jc\" type=\"floating\"><parent link=\"world\"/><child link=\"cube\"/>"
-    "<origin xyz=\"0 0 1\" rpy=\"0.1 0.2 0.3\"/></joint>"
-    "<joint name=\"jb\" type=\"revolute\"><parent link=\"world\"/><child link=\"ball\"/>"
-    "<origin xyz=\"1 0 1\"/><axis xyz=\"0 0 1\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1\"/>"
-    "</joint></robot>";
-
-const drb::SceneQueries& queries()
-{
-  static const drb::SceneQueries instance(drb::loadSceneFromUrdf(kUrdf));
-  return instance;
-}
-
-double fuzzedDouble(FuzzedDataProvider& in)
-{
-  static const double kSpecial[] = { std::numeric_limits<double>::quiet_NaN(),
-                                     -std::numeric_limits<double>::quiet_NaN(),
-                                     std::numeric_limits<double>::infinity(),
-                                     -std::numeric_limits<double>::infinity(),
-                                     std::numeric_limits<double>::denorm_min(),
-                                     -std::numeric_limits<double>::denorm_min(),
-                                     std::numeric_limits<double>::min(),
-                                     std::numeric_limits<double>::max(),
-                                     std::numeric_limits<double>::lowest(),
-                                     0.0,
-                                     -0.0,
-                                     1.5707963267948966,
-                                     -1.5707963267948966,
-                                     1e154,
-                                     1e308,
-                                     1.0 };
-  switch (in.ConsumeIntegralInRange<int>(0, 3))
-  {
-    case 0:
-      return in.PickValueInArray(kSpecial);
-    case 1:
-    {
-      std::uint64_t bits = in.ConsumeIntegral<std::uint64_t>();  // any IEEE pattern, NaN payloads included
-      double value;
-      std::memcpy(&value, &bits, sizeof value);
-      return value;
-    }
-    case 2:
-      return in.ConsumeFloatingPoint<double>();
-    default:
-      return in.ConsumeFloatingPointInRange<double>(-10.0, 10.0);
-  }
-}
-
-std::string fuzzedName(FuzzedDataProvider& in)
-{
-  static const char* const kNames[] = { "cube", "ball", "cap", "world", "", "ghost", "cube " };
-  if (in.ConsumeBool())
-    return in.PickValueInArray(kNames);
-  return in.ConsumeRandomLengthString(24);
-}
-
-std::vector<double> fuzzedDoubles(FuzzedDataProvider& in, std::size_t max_count)
-{
-  std::vector<double> values(in.ConsumeIntegralInRange<std::size_t>(0, max_count));
-  // Often a size the service expects, so that validation goes past the size checks.
-  for (double& value : values)
-    value = fuzzedDouble(in);
-  return values;
-}
-
-std::vector<std::uint32_t> fuzzedVertices(FuzzedDataProvider& in)
-{
-  std::vector<std::uint32_t> vertices(in.ConsumeIntegralInRange<std::size_t>(0, 24));
-  for (std::uint32_t& v : vertices)
-    v = in.ConsumeBool() ? in.ConsumeIntegralInRange<std::uint32_t>(0, 120) : in.ConsumeIntegral<std::uint32_t>();
-  return vertices;
-}
-
-std::vector<std::string> fuzzedNames(FuzzedDataProvider& in)
-{
-  std::vector<std::string> names(in.ConsumeIntegralInRange<std::size_t>(0, 4));
-  for (std::string& name : names)
-    name = fuzzedName(in);
-  return names;
-}
 
 void setState(FuzzedDataProvider& in, drb::SceneState& current)
 {
@@ -132,7 +49,9 @@ void setState(FuzzedDataProvider& in, drb::SceneState& current)
   for (drb::NamedState& update : updates)
   {
     update.name = fuzzedName(in);
-    for (int k = 0; k < 6; ++k)
+    const int index = drb_fuzz::findBody(queries().scene(), update.name);
+    update.x.resize(index >= 0 ? static_cast<Eigen::Index>(queries().dofs(static_cast<std::size_t>(index))) : 6);
+    for (Eigen::Index k = 0; k < update.x.size(); ++k)
       update.x[k] = fuzzedDouble(in);
   }
   drb::SceneState next;
@@ -360,7 +279,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   drb::SceneState current = queries().initialState();
   for (int request = 0; request < 8 && in.remaining_bytes() > 0; ++request)
   {
-    switch (in.ConsumeIntegralInRange<int>(0, 6))
+    switch (in.ConsumeIntegralInRange<int>(0, 8))
     {
       case 0:
         setState(in, current);
@@ -380,8 +299,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       case 5:
         vertexRotationJacobians<float>(in, current);
         break;
-      default:
+      case 6:
         backprop(in, current);
+        break;
+      case 7:
+        drb_fuzz::inverseDynamicsRequest(in, current);
+        break;
+      default:
+        drb_fuzz::forwardDynamicsRequest(in, current);
         break;
     }
   }
