@@ -19,6 +19,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 from report_format import NOT_NODE, fmt_ratio, fmt_time, kernel_table, load, md_table, verdict  # noqa: E402
 from report_articulated import section_articulated  # noqa: E402
+from report_gimbal import section_gimbal  # noqa: E402
 from report_kernels import (plot_kernels, section_backprop, section_floors, section_jacobians,  # noqa: E402
                             section_mass_matrix)
 
@@ -294,6 +295,9 @@ def main():
     articulated_path = os.path.join(args.results, "articulated.json")  # drb_bench_articulated
     if os.path.exists(articulated_path):
         parts.append(section_articulated(load(articulated_path), targets))
+    gimbal_path = os.path.join(args.results, "gimbal.json")  # drb_bench_gimbal
+    if os.path.exists(gimbal_path):
+        parts.append(section_gimbal(load(gimbal_path), targets))
     client_path = os.path.join(args.results, "client_trajectory.md")  # written by bench/client_trajectory.py
     if os.path.exists(client_path):
         parts.append(open(client_path).read().strip())

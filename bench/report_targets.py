@@ -1,5 +1,5 @@
-"""The targets of issues 18 (one body model: M, dM/dx, vertices) and 20
-(dynamics) for the targets table of docs/benchmarks.md, from the rows of
+"""The targets of issues 18 (one body model: M, dM/dx, vertices), 20
+(dynamics) and 28 (motion coordinates inside) for the targets table of docs/benchmarks.md, from the rows of
 report_articulated.py: one line per target, each robot's measured ratio,
 met only when every robot it names meets it."""
 from report_format import EPS, verdict
@@ -114,4 +114,34 @@ def articulated_targets(rows):
                ALL, lambda r: worst_error(r, ["dtau_dx.ours", "dtau_dxd.ours", "dfd_dx.ours", "dfd_dxd.ours",
                                               "minv.ours"]), lambda v: v <= FEW_ULP, " ε"),
     ]
-    return lines
+    return lines + issue28_targets(rows)
+
+
+def issue28_targets(rows):
+    """Issue 28: every algorithm against Pinocchio, M against crba with a margin, and the costs in units of one M
+    and of the memory floors (its gimbal-lock targets: report_gimbal.py)."""
+    faster = lambda q: (lambda r: quotient(r.t(q, "pinocchio"), r.t(q, "ours")))  # noqa: E731
+    ours_m = lambda r: r.t("mass_matrix", "ours")  # noqa: E731
+    worst_vs_pinocchio = lambda r: min(  # noqa: E731
+        [v for v in (faster(q)(r) for q in ("mass_matrix", "inverse_dynamics", "inverse_dynamics_derivatives",
+                                            "forward_dynamics", "forward_dynamics_derivatives")) if v is not None],
+        default=None)
+    floor = lambda kind, which: (lambda r: quotient(r.find(kind, "ours")[0], r.find(kind, which)[0]))  # noqa: E731
+    return [
+        target(rows, "Issue 28: every algorithm (M, ID, its derivatives, FD, its derivatives) at least as fast as "
+               "Pinocchio's, the slowest ratio shown", ALL, worst_vs_pinocchio, lambda v: v >= 1),
+        target(rows, "Issue 28: FD derivatives at least as fast as `computeABADerivatives`", ALL,
+               faster("forward_dynamics_derivatives"), lambda v: v >= 1),
+        target(rows, "Issue 28: M ≥ 1.15× faster than `crba` (Panda, UR5)", ARMS, faster("mass_matrix"),
+               lambda v: v >= 1.15),
+        target(rows, "Issue 28: FD ≤ 1.5× one M", ALL,
+               lambda r: quotient(r.t("forward_dynamics", "ours"), ours_m(r)), lambda v: v <= 1.5),
+        target(rows, "Issue 28: M with dM/dx ≤ 3× one M", ALL,
+               lambda r: quotient(r.t("mass_matrix_derivatives", "ours"), ours_m(r)), lambda v: v <= 3),
+        target(rows, "Issue 28: Panda, all vertices: J ≤ 2× its write floor", ("panda",),
+               floor("jacobian", "floor_write"), lambda v: v <= 2),
+        target(rows, "Issue 28: Panda, all vertices: backprop ≤ 1.5× its read floor", ("panda",),
+               floor("backprop", "floor_read"), lambda v: v <= 1.5),
+        target(rows, "Issue 28: floating humanoid backprop ≤ 3× its read floor", ("humanoid_floating",),
+               floor("backprop", "floor_read"), lambda v: v <= 3),
+    ]
