@@ -118,6 +118,21 @@ struct AbaDerivatives
   const RowMatrixXd& Minv;    ///< nv x nv, symmetric, full (= ddq/dtau)
 };
 
+/// A link frame's Jacobian and classical acceleration from frameJacobian().
+struct FrameJacobian
+{
+  const Matrix6Xd& J;                   ///< 6 x nv, rows linear then angular, in the requested reference
+  Eigen::Matrix<double, 6, 1> classical;  ///< getFrameClassicalAcceleration at a = 0, same reference
+};
+
+/// The centre of mass from centerOfMass().
+struct CenterOfMass
+{
+  Eigen::Vector3d com;          ///< world [m]
+  const Eigen::Matrix3Xd& J;    ///< 3 x nv (jacobianCenterOfMass)
+  Eigen::Vector3d acceleration;  ///< at a = 0 [m/s^2]
+};
+
 /// A URDF loaded by Pinocchio, with its Data.
 class PinocchioRobot
 {
@@ -176,6 +191,17 @@ public:
   /// at v0 + w x p, so its 3 x nv Jacobian is J_lin - [p]_x J_ang over the
   /// columns of the joints that support it (the others must be zeroed).
   const Matrix6Xd& computeJointJacobians(const Eigen::VectorXd& q);
+
+  /// The frame of URDF link `link`: computeFrameJacobian in `reference` (0
+  /// WORLD, 1 LOCAL, 2 LOCAL_WORLD_ALIGNED) and getFrameClassicalAcceleration
+  /// at (q, v, a = 0). Throws std::invalid_argument for an unknown link.
+  FrameJacobian frameJacobian(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const std::string& link,
+                              int reference);
+  /// The centre of mass of the subtree below the joint named `joint`, its
+  /// Jacobian (jacobianSubtreeCenterOfMass) and its acceleration at
+  /// (q, v, a = 0) (centerOfMass's subtree values). Throws
+  /// std::invalid_argument for an unknown joint.
+  CenterOfMass centerOfMass(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const std::string& joint);
 
   /// Inverse dynamics tau = M(q) a + C(q, v) v + g(q) [N, N m].
   const Eigen::VectorXd& rnea(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& a);

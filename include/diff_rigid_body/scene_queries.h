@@ -98,6 +98,31 @@ struct ForwardDynamicsAnswer
   std::vector<double> cos_theta;
 };
 
+/// ~get_frame_jacobians' answer: per configuration k and listed frame f
+/// (frame-major within a configuration), slot n = k F + f of F frames.
+struct FrameJacobianAnswer
+{
+  std::vector<std::string> frames;
+  std::uint32_t dofs = 0;                 ///< d of the body
+  std::vector<double> poses;              ///< 12 per slot: position, then the rotation row-major
+  std::vector<double> jacobians;          ///< 6 d per slot, row-major, rows linear then angular
+  std::vector<double> acceleration_bias;  ///< 6 per slot, when asked
+  std::vector<double> cos_theta;          ///< one per configuration, as MassMatrixAnswer
+};
+
+/// ~get_center_of_mass' answer: per configuration k and listed body i
+/// (body-major within a configuration), slot n = k n_bodies + i.
+struct CenterOfMassAnswer
+{
+  std::vector<std::string> bodies;
+  std::vector<std::uint32_t> dofs;
+  std::vector<double> masses;             ///< per listed body [kg]
+  std::vector<double> com;                ///< 3 per slot, fixed frame [m]
+  std::vector<double> jacobians;          ///< 3 d_i per slot, row-major, when asked
+  std::vector<double> acceleration_bias;  ///< 3 per slot, when asked [m/s^2]
+  std::vector<double> cos_theta;          ///< per slot
+};
+
 /// Standard gravity in the fixed frame, -9.81 m/s^2 along z (~gravity's default).
 inline Eigen::Vector3d standardGravity()
 {
@@ -234,6 +259,26 @@ public:
   void forwardDynamics(const SceneState& current, const std::vector<std::string>& names,
                        const std::vector<double>& q, const std::vector<double>& qdot, const std::vector<double>& tau,
                        bool derivatives, ForwardDynamicsAnswer& answer) const;
+
+  /// Poses, Jacobians (in `reference`: 0 WORLD, 1 LOCAL, 2
+  /// LOCAL_WORLD_ALIGNED; frame_jacobians.h) and, when `acceleration_bias`,
+  /// the classical acceleration biases of the link frames `frames` of
+  /// `body` (empty = every link of the body, in model.links order; a static
+  /// link: fixed pose, zero columns and bias), at K configurations (q: K d
+  /// values; empty = the current state) with qdot of q's length or empty
+  /// (zeros). Refused, before anything is computed: an unknown body or
+  /// frame (naming it and the known ones), an unknown reference, lengths
+  /// that do not match, non-finite values, an answer over
+  /// RequestLimits::kMaxMassMatrixDoubles; after: a result that is not finite.
+  void frameJacobians(const SceneState& current, const std::string& body, const std::vector<std::string>& frames,
+                      const std::vector<double>& q, const std::vector<double>& qdot, std::uint32_t reference,
+                      bool acceleration_bias, FrameJacobianAnswer& answer) const;
+
+  /// Centre of mass of the bodies `names` (empty = all), and with
+  /// `jacobians` its Jacobian and acceleration bias, laid out and checked as
+  /// inverseDynamics (qdot in place of qddot); a massless body is refused.
+  void centerOfMass(const SceneState& current, const std::vector<std::string>& names, const std::vector<double>& q,
+                    const std::vector<double>& qdot, bool jacobians, CenterOfMassAnswer& answer) const;
 
   /// This thread's workspace for body `index`, made on first use and kept
   /// for the thread's next calls on this SceneQueries: queries allocate

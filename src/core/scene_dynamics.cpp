@@ -12,50 +12,15 @@
 
 namespace diff_rigid_body
 {
+using detail::checkDynamicsBudget;
+using detail::dynamicsConfigurations;
 using detail::reject;
+using detail::setBodies;
 using detail::sizeMismatch;
+using detail::slice;
 
 namespace
 {
-/// The K of a dynamics request: from q (K D values; empty = 1), with each
-/// other array of q's length (K D) or empty, every value finite.
-std::size_t dynamicsConfigurations(const detail::RequestLayout& layout, std::size_t bodies,
-                                   const std::vector<double>& q,
-                                   std::initializer_list<std::pair<const char*, const std::vector<double>*>> others)
-{
-  if (!q.empty() && (bodies == 0 || q.size() % layout.D != 0))
-    reject(sizeMismatch("q",
-                        "a multiple of " + std::to_string(layout.D) + " values (the sum of the " +
-                            std::to_string(bodies) + " bodies' dofs), or empty for the current state",
-                        q.size()));
-  const std::size_t configurations = q.empty() ? 1 : q.size() / layout.D;
-  requireFinite(q.data(), q.size(), "q");
-  for (const auto& [field, values] : others)
-  {
-    if (!values->empty() && values->size() != configurations * layout.D)
-      reject(sizeMismatch(field,
-                          std::to_string(configurations * layout.D) + " values (q's " + std::to_string(configurations) +
-                              " configuration(s) x " + std::to_string(layout.D) + "), or empty for zeros",
-                          values->size()));
-    requireFinite(values->data(), values->size(), field);
-  }
-  return configurations;
-}
-
-/// Refuses an answer of more doubles than the budget of get_mass_matrix
-/// (with matrices: its budget with derivatives).
-void checkDynamicsBudget(std::size_t configurations, std::size_t per_configuration, bool matrices)
-{
-  const std::size_t budget =
-      matrices ? RequestLimits::kMaxMassMatrixDoublesWithDerivatives : RequestLimits::kMaxMassMatrixDoubles;
-  if (per_configuration == 0 || configurations <= budget / per_configuration)
-    return;
-  std::ostringstream why;
-  why << "q: expected at most " << budget << " answer values, got " << configurations << " configuration(s) x "
-      << per_configuration << " values";
-  reject(why.str());
-}
-
 /// `matrix` (d x d, column-major) row-major at `out`, times `scale`.
 void writeRowMajor(const Eigen::MatrixXd& matrix, double scale, double* out)
 {
@@ -87,22 +52,6 @@ std::string singularReason(const BodyModel& body, const double* x, int coordinat
   return why.str();
 }
 
-template <typename Answer>
-void setBodies(const SceneQueries& queries, const std::vector<std::size_t>& indices, Answer& answer)
-{
-  answer.bodies.resize(indices.size());
-  answer.dofs.resize(indices.size());
-  for (std::size_t i = 0; i < indices.size(); ++i)
-  {
-    answer.bodies[i] = queries.body(indices[i]).name;
-    answer.dofs[i] = static_cast<std::uint32_t>(queries.dofs(indices[i]));
-  }
-}
-
-const double* slice(const std::vector<double>& values, std::size_t offset)
-{
-  return values.empty() ? nullptr : values.data() + offset;
-}
 }  // namespace
 
 void SceneQueries::inverseDynamics(const SceneState& current, const std::vector<std::string>& names,

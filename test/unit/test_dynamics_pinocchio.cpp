@@ -16,6 +16,7 @@
 #include <gtest/gtest.h>
 
 #include "diff_rigid_body/forward_dynamics.h"
+#include "diff_rigid_body/scene_queries.h"
 #include "pinocchio_peer.h"
 #include "../support/dynamics_fixtures.h"
 
@@ -167,6 +168,52 @@ TEST_P(DynamicsPinocchio, ForwardDynamicsAndDerivatives)
     EXPECT_LT(relativeDifference(inverse_mass, A.transpose() * Matrix(derivatives.Minv) * A), kAgreement)
         << fixture_.name;
   }
+}
+
+TEST_P(DynamicsPinocchio, FrameJacobiansAndCenterOfMass)
+{
+  // Every link frame in the three references (J and the classical
+  // acceleration at x'' = 0) and the body's COM (its subtree in Pinocchio),
+  // through SceneQueries as the node serves them.
+  std::mt19937_64 rng(13 + GetParam());
+  const drb::SceneQueries queries(fixture_.scene);
+  const Eigen::Index d = static_cast<Eigen::Index>(model().coordinates);
+  const Matrix& A = map_.A;
+  const auto m = drb_test::dynamics::randomMotion(model(), rng);
+  const Vector q = robot_.configuration(A * m.x + map_.offset), v = A * m.xd;
+  const std::vector<double> x(m.x.data(), m.x.data() + d), xd(m.xd.data(), m.xd.data() + d);
+  for (std::uint32_t reference = 0; reference < 3; ++reference)
+  {
+    drb::FrameJacobianAnswer answer;
+    queries.frameJacobians(queries.initialState(), model().name, {}, x, xd, reference, true, answer);
+    ASSERT_EQ(answer.frames.size(), model().links.size());
+    for (std::size_t f = 0; f < answer.frames.size(); ++f)
+    {
+      const auto peer = robot_.frameJacobian(q, v, answer.frames[f], static_cast<int>(reference));
+      const Matrix J = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+          answer.jacobians.data() + 6 * d * static_cast<Eigen::Index>(f), 6, d);
+      const std::string at = fixture_.name + ": frame " + answer.frames[f] + ", reference " + std::to_string(reference);
+      EXPECT_LT(relativeDifference(J, Matrix(peer.J * A)), kAgreement) << at;
+      EXPECT_LT(relativeDifference(Eigen::Map<const Vector>(answer.acceleration_bias.data() + 6 * f, 6),
+                                   Vector(peer.classical)),
+                kAgreement)
+          << at;
+    }
+  }
+  const std::string root_joint = model().hasFreeRoot() ? model().joint_name + "_translation" : model().segments[0].joint;
+  const auto peer = robot_.centerOfMass(q, v, root_joint);
+  drb::CenterOfMassAnswer com;
+  queries.centerOfMass(queries.initialState(), { model().name }, x, xd, true, com);
+  EXPECT_LT(relativeDifference(Eigen::Map<const Vector>(com.com.data(), 3), Vector(peer.com)), kAgreement);
+  EXPECT_LT(relativeDifference(Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+                                   com.jacobians.data(), 3, d),
+                               Matrix(peer.J * A)),
+            kAgreement)
+      << fixture_.name << ": COM Jacobian";
+  // A free body's COM is its (tx, ty, tz): J'x' = 0, so the scale is 1 m/s^2.
+  const Vector acceleration_error = Eigen::Map<const Vector>(com.acceleration_bias.data(), 3) - peer.acceleration;
+  EXPECT_LT(acceleration_error.cwiseAbs().maxCoeff(), kAgreement * std::max(1.0, peer.acceleration.norm()))
+      << fixture_.name << ": COM acceleration";
 }
 
 INSTANTIATE_TEST_SUITE_P(Bodies, DynamicsPinocchio, ::testing::Range<std::size_t>(0, dynamicsBodies().size()),

@@ -1,0 +1,191 @@
+// SceneQueries::frameJacobians and centerOfMass: the requests' checks and
+// layout, and frame_jacobians.h per configuration.
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "diff_rigid_body/frame_jacobians.h"
+#include "diff_rigid_body/kinematics.h"
+#include "diff_rigid_body/scene_queries.h"
+#include "request_checks.h"
+#include "request_layout.h"
+
+namespace diff_rigid_body
+{
+using detail::checkDynamicsBudget;
+using detail::dynamicsConfigurations;
+using detail::reject;
+using detail::setBodies;
+using detail::slice;
+
+namespace
+{
+/// A listed frame: a link of the body (model.links index), or a static link
+/// (scene.static_links index, `fixed`).
+struct FrameSlot
+{
+  std::size_t index = 0;
+  bool fixed = false;
+};
+
+/// "a, b, c" of at most 20 names, then how many there are.
+template <typename Names>
+std::string listed(const Names& names)
+{
+  constexpr std::size_t kListed = 20;
+  std::string out;
+  for (std::size_t i = 0; i < std::min(kListed, names.size()); ++i)
+    out += (i ? ", " : "") + names[i].name;
+  if (names.size() > kListed)
+    out += ", ... (" + std::to_string(names.size()) + ")";
+  return out;
+}
+
+/// The slots of `frames` (empty = every link of the body), or a refusal
+/// naming the unknown frame and the body's links.
+void frameSlots(const Scene& scene, const BodyModel& body, const std::vector<std::string>& frames,
+                std::vector<FrameSlot>& slots)
+{
+  slots.clear();
+  if (frames.empty())
+  {
+    for (std::size_t l = 0; l < body.links.size(); ++l)
+      slots.push_back({ l, false });
+    return;
+  }
+  if (frames.size() > RequestLimits::kMaxStates)
+    reject(detail::sizeMismatch("frames", "at most " + std::to_string(RequestLimits::kMaxStates) + " names",
+                                frames.size()));
+  for (std::size_t f = 0; f < frames.size(); ++f)
+  {
+    const auto in_body = std::find_if(body.links.begin(), body.links.end(),
+                                      [&](const LinkInBody& link) { return link.name == frames[f]; });
+    if (in_body != body.links.end())
+    {
+      slots.push_back({ static_cast<std::size_t>(in_body - body.links.begin()), false });
+      continue;
+    }
+    const auto fixed = std::find_if(scene.static_links.begin(), scene.static_links.end(),
+                                    [&](const StaticLink& link) { return link.name == frames[f]; });
+    if (fixed != scene.static_links.end())
+    {
+      slots.push_back({ static_cast<std::size_t>(fixed - scene.static_links.begin()), true });
+      continue;
+    }
+    const std::string name = frames[f].size() > 64 ? frames[f].substr(0, 64) + "..." : frames[f];
+    reject("frames[" + std::to_string(f) + "]: unknown frame '" + name + "': not a link of body '" + body.name +
+           "' (its links: " + listed(body.links) + ") nor a static link" +
+           (scene.static_links.empty() ? "" : " (" + listed(scene.static_links) + ")"));
+  }
+}
+
+FrameReference frameReference(std::uint32_t reference)
+{
+  if (reference > 2)
+    reject("reference: " + std::to_string(reference) +
+           " is not one of 0 (WORLD), 1 (LOCAL), 2 (LOCAL_WORLD_ALIGNED)");
+  return static_cast<FrameReference>(reference);
+}
+
+/// A static link's slot: its fixed pose, zero Jacobian and bias.
+void writeStaticFrame(const StaticLink& link, std::size_t d, double* pose12, double* jacobian, double* bias)
+{
+  const Eigen::Vector3d p = link.pose_in_fixed_frame.translation();
+  const Eigen::Matrix3d R = link.pose_in_fixed_frame.linear();
+  for (int i = 0; i < 3; ++i)
+    pose12[i] = p[i];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      pose12[3 + 3 * r + c] = R(r, c);
+  std::fill(jacobian, jacobian + 6 * d, 0.0);
+  if (bias)
+    std::fill(bias, bias + 6, 0.0);
+}
+}  // namespace
+
+void SceneQueries::frameJacobians(const SceneState& current, const std::string& body_name,
+                                  const std::vector<std::string>& frames, const std::vector<double>& q,
+                                  const std::vector<double>& qdot, std::uint32_t reference, bool acceleration_bias,
+                                  FrameJacobianAnswer& answer) const
+{
+  const std::size_t index = bodyIndex(body_name, "body");
+  const BodyModel& body = scene_.bodies[index];
+  thread_local std::vector<FrameSlot> slots;
+  frameSlots(scene_, body, frames, slots);
+  const FrameReference ref = frameReference(reference);
+  thread_local std::vector<std::size_t> indices;
+  indices.assign(1, index);
+  const detail::RequestLayout& layout = detail::requestLayout(*this, indices);
+  const std::size_t K = dynamicsConfigurations(layout, 1, q, { { "qdot", &qdot } });
+  const std::size_t d = body.coordinates, F = slots.size();
+  checkDynamicsBudget(K, F * (12 + 6 * d + (acceleration_bias ? 6 : 0)) + 1, true);
+  answer.frames.resize(F);
+  for (std::size_t f = 0; f < F; ++f)
+    answer.frames[f] = slots[f].fixed ? scene_.static_links[slots[f].index].name : body.links[slots[f].index].name;
+  answer.dofs = static_cast<std::uint32_t>(d);
+  answer.poses.resize(K * F * 12);
+  answer.jacobians.resize(K * F * 6 * d);
+  answer.acceleration_bias.resize(acceleration_bias ? K * F * 6 : 0);
+  answer.cos_theta.resize(K);
+  BodyWorkspace<double>& ws = workspace(index);
+  for (std::size_t k = 0; k < K; ++k)
+  {
+    const double* x = q.empty() ? current[index].data() : q.data() + k * d;
+    forwardKinematics(body, ws, x);
+    if (acceleration_bias)
+      frameMotion(body, ws, slice(qdot, k * d));
+    for (std::size_t f = 0; f < F; ++f)
+    {
+      const std::size_t n = k * F + f;
+      double* bias = acceleration_bias ? answer.acceleration_bias.data() + 6 * n : nullptr;
+      if (slots[f].fixed)
+        writeStaticFrame(scene_.static_links[slots[f].index], d, answer.poses.data() + 12 * n,
+                         answer.jacobians.data() + 6 * d * n, bias);
+      else
+        frameJacobian(body, ws, slots[f].index, ref, answer.poses.data() + 12 * n,
+                      answer.jacobians.data() + 6 * d * n, bias);
+    }
+    answer.cos_theta[k] = body.hasFreeRoot() ? std::cos(x[THETA]) : 1.0;
+  }
+  requireFinite(answer.poses.data(), answer.poses.size(), "result poses");
+  requireFinite(answer.jacobians.data(), answer.jacobians.size(), "result jacobians");
+  requireFinite(answer.acceleration_bias.data(), answer.acceleration_bias.size(), "result acceleration_bias");
+}
+
+void SceneQueries::centerOfMass(const SceneState& current, const std::vector<std::string>& names,
+                                const std::vector<double>& q, const std::vector<double>& qdot, bool jacobians,
+                                CenterOfMassAnswer& answer) const
+{
+  thread_local std::vector<std::size_t> indices;
+  bodyIndices(names, "bodies", indices);
+  const detail::RequestLayout& layout = detail::requestLayout(*this, indices);
+  const std::size_t n = indices.size();
+  const std::size_t K = dynamicsConfigurations(layout, n, q, { { "qdot", &qdot } });
+  checkDynamicsBudget(K, 4 * n + (jacobians ? 3 * layout.D + 3 * n : 0), jacobians);
+  for (std::size_t i = 0; i < n; ++i)
+    if (!(scene_.bodies[indices[i]].mass() > 0.0))
+      reject("bodies[" + std::to_string(i) + "]: body '" + scene_.bodies[indices[i]].name +
+             "' has no mass, so its centre of mass is undefined");
+  setBodies(*this, indices, answer);
+  answer.masses.resize(n);
+  answer.com.resize(K * n * 3);
+  answer.jacobians.resize(jacobians ? K * 3 * layout.D : 0);
+  answer.acceleration_bias.resize(jacobians ? K * n * 3 : 0);
+  answer.cos_theta.resize(K * n);
+  for (std::size_t k = 0; k < K; ++k)
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      const BodyModel& body = scene_.bodies[indices[i]];
+      const std::size_t v = k * layout.D + layout.x_offset[i], slot = k * n + i;
+      const double* x = q.empty() ? current[indices[i]].data() : q.data() + v;
+      answer.masses[i] = diff_rigid_body::centerOfMass(body, workspace(indices[i]), x, slice(qdot, v), answer.com.data() + 3 * slot,
+                                      jacobians ? answer.jacobians.data() + 3 * v : nullptr,
+                                      jacobians ? answer.acceleration_bias.data() + 3 * slot : nullptr);
+      answer.cos_theta[slot] = body.hasFreeRoot() ? std::cos(x[THETA]) : 1.0;
+    }
+  requireFinite(answer.com.data(), answer.com.size(), "result com");
+  requireFinite(answer.jacobians.data(), answer.jacobians.size(), "result jacobians");
+  requireFinite(answer.acceleration_bias.data(), answer.acceleration_bias.size(), "result acceleration_bias");
+}
+
+}  // namespace diff_rigid_body
