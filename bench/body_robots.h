@@ -1,6 +1,6 @@
 // The robots of drb_bench_articulated (bench_articulated.cpp) and what every
 // row measures them at: the Panda, the UR5 and simple_humanoid of
-// test/robots/example-robot-data in model mode (JointHandling::Model), the
+// test/robots/drb_example_robot_data in model mode (JointHandling::Model), the
 // humanoid twice, on its fixed base and with a floating root.
 //
 // A robot is every body of its scene (body_model.h), its x the bodies' x
@@ -202,7 +202,7 @@ inline void loadModel(Robot& robot)
   drb::SceneOptions options;
   options.joints = drb::JointHandling::Model;
   options.find_package = [root](const std::string& package) {
-    return package == "example-robot-data" ? root : std::string();
+    return package == "drb_example_robot_data" ? root : std::string();
   };
   robot.queries = std::make_shared<const drb::SceneQueries>(drb::loadSceneFromUrdfFile(robot.urdf, options));
   for (const drb::BodyModel& body : robot.bodies())

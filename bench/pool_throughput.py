@@ -37,8 +37,8 @@ REPO = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 import pool_report  # noqa: E402  (bench/, beside this script)
 
-PANDA = os.path.join(REPO, 'test/robots/example-robot-data/robots/panda_description/urdf/panda.urdf')
-HUMANOID = os.path.join(REPO, 'test/robots/example-robot-data/robots/simple_humanoid_description/urdf/'
+PANDA = os.path.join(REPO, 'test/robots/drb_example_robot_data/robots/panda_description/urdf/panda.urdf')
+HUMANOID = os.path.join(REPO, 'test/robots/drb_example_robot_data/robots/simple_humanoid_description/urdf/'
                               'simple_humanoid.urdf')
 SIZES = (1, 2, 4)
 K = 1000

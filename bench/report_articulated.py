@@ -158,7 +158,7 @@ def section_articulated(data, targets):
     text = ["## Bodies with joints: kinematics, M, dM/dx, vertices, dynamics",
             "",
             "`drb_bench_articulated` (bench/bench_articulated.cpp, bench_bodies.cpp, bench_dynamics.cpp): the Panda "
-            "(`panda.urdf`), the UR5 (`ur5_robot.urdf`) and simple_humanoid of test/robots/example-robot-data loaded "
+            "(`panda.urdf`), the UR5 (`ur5_robot.urdf`) and simple_humanoid of test/robots/drb_example_robot_data loaded "
             "with `JointHandling::Model`; the humanoid on its fixed base (BODY is welded to base_link, so its legs "
             "and its waist with torso and arms are three fixed-base bodies, 29 coordinates, timed together) and with "
             "its `waist` joint made `floating` (one body, a free root with 29 joints: 35 coordinates). Peers on the "

@@ -25,7 +25,7 @@ namespace drb_test
 namespace articulated
 {
 const std::string kRobotsDir = std::string(DRB_TEST_DATA_DIR) + "/robots";
-const std::string kErd = kRobotsDir + "/example-robot-data/robots";
+const std::string kErd = kRobotsDir + "/drb_example_robot_data/robots";
 
 struct Fixture
 {
@@ -56,13 +56,13 @@ inline std::string readText(const std::string& path)
   return text.str();
 }
 
-/// package://example-robot-data and package://urdf_tutorial from test/robots.
+/// package://drb_example_robot_data and package://urdf_tutorial from test/robots.
 inline diff_rigid_body::SceneOptions robotOptions(diff_rigid_body::JointHandling joints)
 {
   diff_rigid_body::SceneOptions options;
   options.joints = joints;
   options.find_package = [](const std::string& package) {
-    return package == "example-robot-data" || package == "urdf_tutorial" ? kRobotsDir + "/" + package : "";
+    return package == "drb_example_robot_data" || package == "urdf_tutorial" ? kRobotsDir + "/" + package : "";
   };
   return options;
 }

@@ -44,7 +44,7 @@ namespace
 {
 namespace drb = diff_rigid_body;
 
-const std::string kRobots = std::string(DRB_TEST_DATA_DIR) + "/robots/example-robot-data";
+const std::string kRobots = std::string(DRB_TEST_DATA_DIR) + "/robots/drb_example_robot_data";
 
 /// Allocations made by `call` (run once before, to warm up its buffers).
 template <typename Call>

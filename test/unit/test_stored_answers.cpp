@@ -76,7 +76,7 @@ struct SceneSpec
   std::vector<std::pair<std::string, Kind>> bodies;  ///< expected, in scene order
 };
 
-/// package://diff_rigid_body (the checkout) and package://example-robot-data (test/robots).
+/// package://diff_rigid_body (the checkout) and package://drb_example_robot_data (test/robots).
 drb::SceneOptions optionsFor(const SceneSpec& spec)
 {
   drb::SceneOptions options;
@@ -84,7 +84,7 @@ drb::SceneOptions optionsFor(const SceneSpec& spec)
   options.find_package = [](const std::string& package) -> std::string {
     if (package == "diff_rigid_body")
       return kTestDir + "/..";
-    return package == "example-robot-data" ? kTestDir + "/robots/example-robot-data" : "";
+    return package == "drb_example_robot_data" ? kTestDir + "/robots/drb_example_robot_data" : "";
   };
   return options;
 }
