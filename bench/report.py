@@ -255,7 +255,8 @@ def section_scene(scene):
                      f"{100 * s['cpu_one_subscriber']:.1f} %", f"{rate:.1f} Hz"])
     return "\n".join(["## 6. Scene scale", "",
                       "Generated URDFs of boxes on floating joints; the node with `~publish_rate` 50 Hz. Load: from "
-                      "process start to the node's 'serving' log line, and to its services being registered. "
+                      "process start to the node's 'serving' log line (written once its services are advertised), and to "
+                      "its services being registered. "
                       f"CPU: the node's utime + stime from /proc/<pid>/stat over {scene['cpu_window_s']:.0f} s, in "
                       "% of one core, with no tf subscriber and with one C++ subscriber to /tf (its received rate "
                       "in the last column).", "",

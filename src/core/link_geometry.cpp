@@ -37,20 +37,22 @@ std::string resolveMeshPath(const std::string& uri, const std::string& link_name
     const std::string rest = uri.substr(package_scheme.size());
     const std::size_t slash = rest.find('/');
     const std::string package = rest.substr(0, slash);
-    std::string root;
+    std::string root, reason;
     if (options.find_package)
     {
       try
       {
         root = options.find_package(package);
       }
-      catch (const std::exception&)
+      catch (const std::exception& e)
       {
         root.clear();
+        reason = e.what();
       }
     }
     if (root.empty())
-      throw MeshLoadError("link '" + link_name + "': mesh '" + uri + "': cannot find package '" + package + "'");
+      throw MeshLoadError("link '" + link_name + "': mesh '" + uri + "': cannot find package '" + package + "'" +
+                          (reason.empty() ? "" : ": " + reason));
     const std::string inside = slash == std::string::npos ? "" : rest.substr(slash);
     // A package:// URI names a file inside the package: '..' may not leave it.
     const std::filesystem::path normal = std::filesystem::path("." + inside).lexically_normal();
@@ -72,18 +74,24 @@ std::string resolveMeshPath(const std::string& uri, const std::string& link_name
 const TriangleMesh& GeometryMeshes::meshFile(const urdf::Mesh& mesh, const std::string& link_name)
 {
   const std::string path = resolveMeshPath(mesh.filename, link_name, options_);
+  // The URI as written in the URDF; the loader's messages name the file it resolved to.
+  const std::string written = "link '" + link_name + "': " +
+                              (path == mesh.filename ? std::string() : "mesh '" + mesh.filename + "': ");
   const Eigen::Vector3d scale(mesh.scale.x, mesh.scale.y, mesh.scale.z);
   const auto key = std::make_pair(path, std::array<double, 3>{ scale.x(), scale.y(), scale.z() });
   auto found = cache_.find(key);
   if (found == cache_.end())
   {
+    std::error_code error;
+    if (!std::filesystem::exists(path, error) && !error)  // an error (e.g. a symlink loop): the reader says
+      throw MeshLoadError(written + "mesh '" + path + "': no such file");
     try
     {
       found = cache_.emplace(key, loadMeshFile(path, scale)).first;
     }
     catch (const MeshLoadError& e)
     {
-      throw MeshLoadError("link '" + link_name + "': " + e.what());
+      throw MeshLoadError(written + e.what());
     }
   }
   return found->second;

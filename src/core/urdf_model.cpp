@@ -41,7 +41,7 @@ urdf::ModelInterfaceSharedPtr parseUrdfModel(const std::string& urdf_xml)
   CapturedUrdfdomErrors errors;
   urdf::ModelInterfaceSharedPtr model = urdf::parseURDF(urdf_xml);
   if (!model || !errors.text().empty())
-    throw SceneDescriptionError("robot description: urdfdom rejected it: " +
+    throw SceneDescriptionError("urdfdom rejected it: " +
                                 (errors.text().empty() ? std::string("(no reason given)") : errors.text()));
   return model;
 }
@@ -52,12 +52,12 @@ std::vector<std::string> namesInDocumentOrder(const std::string& urdf_xml, const
   if (document.Parse(urdf_xml.c_str(), urdf_xml.size()) != tinyxml2::XML_SUCCESS)
   {
     std::ostringstream why;
-    why << "robot description: malformed XML at line " << document.ErrorLineNum() << ": " << document.ErrorStr();
+    why << "malformed XML at line " << document.ErrorLineNum() << ": " << document.ErrorStr();
     throw SceneDescriptionError(why.str());
   }
   const tinyxml2::XMLElement* robot = document.FirstChildElement("robot");
   if (!robot)
-    throw SceneDescriptionError("robot description: no <robot> element");
+    throw SceneDescriptionError("no <robot> element");
   std::vector<std::string> names;
   for (const tinyxml2::XMLElement* child = robot->FirstChildElement(element); child;
        child = child->NextSiblingElement(element))
@@ -69,19 +69,26 @@ std::vector<std::string> namesInDocumentOrder(const std::string& urdf_xml, const
   return names;
 }
 
-UrdfDescription readUrdfDescription(const std::string& urdf_xml)
+UrdfDescription readUrdfDescription(const std::string& urdf_xml, const std::string& source)
 {
   UrdfDescription description;
-  description.link_order = namesInDocumentOrder(urdf_xml, "link");
-  description.joint_order = namesInDocumentOrder(urdf_xml, "joint");
-  description.model = parseUrdfModel(urdf_xml);
-  std::vector<JointEdge> edges;
-  for (const std::string& name : description.joint_order)
-    if (const urdf::JointConstSharedPtr joint = description.model->getJoint(name))
-      edges.push_back({ name, joint->parent_link_name, joint->child_link_name });
-  checkTreeTopology(description.link_order, edges);
-  if (!description.model->getRoot())
-    throw SceneDescriptionError("robot description: no root link");
+  try
+  {
+    description.link_order = namesInDocumentOrder(urdf_xml, "link");
+    description.joint_order = namesInDocumentOrder(urdf_xml, "joint");
+    description.model = parseUrdfModel(urdf_xml);
+    std::vector<JointEdge> edges;
+    for (const std::string& name : description.joint_order)
+      if (const urdf::JointConstSharedPtr joint = description.model->getJoint(name))
+        edges.push_back({ name, joint->parent_link_name, joint->child_link_name });
+    checkTreeTopology(description.link_order, edges);
+    if (!description.model->getRoot())
+      throw SceneDescriptionError("no root link");
+  }
+  catch (const SceneDescriptionError& e)
+  {
+    throw SceneDescriptionError(source + ": " + e.what());
+  }
   for (std::size_t i = 0; i < description.link_order.size(); ++i)
     description.link_index.emplace(description.link_order[i], i);
   return description;

@@ -41,8 +41,10 @@ struct UrdfDescription
 };
 
 /// Parses `urdf_xml` (parseUrdfModel, namesInDocumentOrder) and checks that
-/// its joints form one tree (checkTreeTopology). Throws SceneDescriptionError.
-UrdfDescription readUrdfDescription(const std::string& urdf_xml);
+/// its joints form one tree (checkTreeTopology). Throws SceneDescriptionError
+/// whose message starts with `source` (e.g. "robot description" or
+/// "URDF file '/path/robot.urdf'"), then what is wrong and where.
+UrdfDescription readUrdfDescription(const std::string& urdf_xml, const std::string& source);
 
 /// Revolute, continuous and prismatic joints: one coordinate each.
 bool movesOneCoordinate(int joint_type);

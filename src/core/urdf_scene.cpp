@@ -5,7 +5,10 @@
 #include "diff_rigid_body/urdf_scene.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -88,9 +91,12 @@ void addBody(const UrdfDescription& description, const LinkTree& tree, const std
 }
 }  // namespace
 
-Scene loadSceneFromUrdf(const std::string& urdf_xml, const SceneOptions& options)
+namespace
 {
-  const UrdfDescription description = detail::readUrdfDescription(urdf_xml);
+// `source` names the description in error messages: "robot description" or "URDF file '<path>'".
+Scene loadScene(const std::string& urdf_xml, const SceneOptions& options, const std::string& source)
+{
+  const UrdfDescription description = detail::readUrdfDescription(urdf_xml, source);
   if (options.density && !(std::isfinite(*options.density) && *options.density > 0.0))
   {
     std::ostringstream why;
@@ -104,20 +110,30 @@ Scene loadSceneFromUrdf(const std::string& urdf_xml, const SceneOptions& options
     if (tree.owner[i].empty() && description.link_order[i] != scene.fixed_frame)
       scene.static_links.push_back({ description.link_order[i], fixed_from_root * tree.pose_in_root[i] });
   if (tree.moving_links.empty())
-    throw SceneDescriptionError("robot description: no body (no link is the child of a floating, revolute, "
-                                "continuous, prismatic or planar joint)");
+    throw SceneDescriptionError(source + ": no body (no link is the child of a floating, revolute, "
+                                         "continuous, prismatic or planar joint)");
   detail::LoadContext context(options);
   for (const std::string& name : selectedRoots(bodyRoots(description, tree, options), options))
     addBody(description, tree, name, fixed_from_root, context, scene);
   scene.warnings = std::move(context.warnings);
   return scene;
 }
+}  // namespace
+
+Scene loadSceneFromUrdf(const std::string& urdf_xml, const SceneOptions& options)
+{
+  return loadScene(urdf_xml, options, "robot description");
+}
 
 Scene loadSceneFromUrdfFile(const std::string& path, SceneOptions options)
 {
+  const std::string source = "URDF file '" + path + "'";
+  std::error_code error;
+  if (!std::filesystem::exists(path, error) && !error)
+    throw SceneDescriptionError(source + ": no such file");
   std::ifstream file(path);
   if (!file)
-    throw SceneDescriptionError("URDF file '" + path + "': cannot be opened");
+    throw SceneDescriptionError(source + ": cannot be opened: " + std::strerror(errno));
   std::stringstream text;
   text << file.rdbuf();
   if (options.base_directory.empty())
@@ -125,7 +141,7 @@ Scene loadSceneFromUrdfFile(const std::string& path, SceneOptions options)
     const std::size_t slash = path.find_last_of('/');
     options.base_directory = slash == std::string::npos ? "." : path.substr(0, slash);
   }
-  return loadSceneFromUrdf(text.str(), options);
+  return loadScene(text.str(), options, source);
 }
 
 }  // namespace diff_rigid_body

@@ -14,7 +14,7 @@ namespace
 {
 [[noreturn]] void refuse(const std::string& why)
 {
-  throw SceneDescriptionError("robot description: " + why + " (a URDF must be a tree of links)");
+  throw SceneDescriptionError(why + " (a URDF must be a tree of links)");
 }
 
 std::string quoted(const std::string& name)

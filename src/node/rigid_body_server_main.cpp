@@ -3,8 +3,11 @@
 // it never half-starts.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <sstream>
+#include <stdexcept>
 
 #include <ros/package.h>
 #include <ros/ros.h>
@@ -38,6 +41,20 @@ std::vector<std::string> readBodies(const ros::NodeHandle& private_nh)
   return bodies;
 }
 
+// package:// resolution as roslib does it (rospack over ROS_PACKAGE_PATH); an unknown package
+// throws, saying where it was looked for and what to check.
+std::string findPackage(const std::string& package)
+{
+  const std::string path = ros::package::getPath(package);
+  if (!path.empty())
+    return path;
+  const char* package_path = std::getenv("ROS_PACKAGE_PATH");
+  throw std::runtime_error("no such package on ROS_PACKAGE_PATH (" +
+                           std::string(package_path && *package_path ? package_path : "unset") +
+                           "): check that ROS_PACKAGE_PATH lists the folder that holds the package '" + package +
+                           "' (e.g. export ROS_PACKAGE_PATH=/path/to/its/parent:$ROS_PACKAGE_PATH)");
+}
+
 drb::SceneOptions readSceneOptions(const ros::NodeHandle& private_nh)
 {
   drb::SceneOptions options;
@@ -59,7 +76,7 @@ drb::SceneOptions readSceneOptions(const ros::NodeHandle& private_nh)
   else if (joints != "model")
     throw drb::SceneDescriptionError("parameter ~joints: must be 'model' or 'free', got '" + joints + "'");
   options.fixed_frame = private_nh.param<std::string>("fixed_frame", "");
-  options.find_package = [](const std::string& package) { return ros::package::getPath(package); };
+  options.find_package = findPackage;
   return options;
 }
 
@@ -92,10 +109,23 @@ drb::Scene loadScene(const ros::NodeHandle& nh, const ros::NodeHandle& private_n
   }
   return drb::loadSceneFromUrdf(urdf_xml, options);
 }
+
+// The line that says the node is ready: "rigid_body_server: serving N bodies in '<fixed frame>': ...".
+std::string servingSummary(const drb::Scene& scene)
+{
+  std::ostringstream summary;
+  summary << "rigid_body_server: serving " << scene.bodies.size() << " bodies in '" << scene.fixed_frame << "':";
+  for (const drb::BodyModel& body : scene.bodies)
+    summary << " " << body.name << " (" << body.coordinates << " coordinates, " << body.vertexCount() << " vertices)";
+  return summary.str();
+}
 }  // namespace
 
 int main(int argc, char** argv)
 {
+  // ROS_INFO goes to stdout: line-buffered, so that a pipe or a log file (roslaunch output="log")
+  // gets each line when it is written, not when the buffer fills or the node exits.
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
   ros::init(argc, argv, "rigid_body_server");
   ros::NodeHandle nh;
   ros::NodeHandle private_nh("~");
@@ -128,18 +158,15 @@ int main(int argc, char** argv)
   for (const std::string& warning : scene.warnings)
     ROS_WARN_STREAM("rigid_body_server: " << warning);
 
-  std::ostringstream summary;
-  for (const drb::BodyModel& body : scene.bodies)
-    summary << " " << body.name << " (" << body.coordinates << " coordinates, " << body.vertexCount() << " vertices)";
-  ROS_INFO_STREAM("rigid_body_server: serving " << scene.bodies.size() << " bodies in '" << scene.fixed_frame
-                                                << "':" << summary.str());
-
+  const std::string summary = servingSummary(scene);
   std::unique_ptr<drb::RigidBodyServer> server;
   // e.g. an unwritable ~state_file
   if (!drb::node::runAtStart("cannot start", [&] {
         server = std::make_unique<drb::RigidBodyServer>(nh, private_nh, std::move(scene), settings);
       }))
     return 1;
+  // Once every service is advertised; stdout is line-buffered (main), so a pipe sees it now.
+  ROS_INFO_STREAM(summary);
   ros::MultiThreadedSpinner spinner(static_cast<std::uint32_t>(threads));
   spinner.spin();
   return 0;

@@ -6,6 +6,8 @@
   private namespace starts clean (server.launch's clear_params), in server.launch and pool.launch.
 - A pool instance that dies (SIGKILL) leaves the other instances and the roslaunch running, and a
   RigidBodyPool over both namespaces still answers (its failover gets its chance).
+- A URDF that does not exist (urdf:=) is refused by the node in one line, without a roslaunch
+  traceback, and the roslaunch ends.
 Oracles: get_bodies' names (the default scene has the bodies knot and rock), the parameter server,
 and tau_z = m |gamma| of a body held still (inverse dynamics at rest, m from get_bodies).
 """
@@ -164,6 +166,18 @@ class LaunchFiles(unittest.TestCase):
         M = pool.mass_matrix(['knot'], q=q[:, None, :]).M
         self.assertEqual(M.shape, (4, 1, 6, 6))
         self.assertEqual([up for _, up, _, _ in pool.status()], [False, True])
+
+    # ------------------------------------------------------------------ a missing URDF file
+    def test_a_missing_urdf_is_refused_by_the_node_in_one_line(self):
+        missing = '/nonexistent/drb/robot.urdf'
+        launched = self.launch('server.launch', 'ns:=missing_urdf', 'urdf:=' + missing)
+        self.assertIsNotNone(launched.wait_for_exit(), 'roslaunch kept running on a missing URDF')
+        output = launched.output()
+        self.assertNotIn('Traceback', output)
+        refusals = [line for line in output.splitlines() if "URDF file '%s'" % missing in line]
+        self.assertEqual(len(refusals), 1, 'expected one line naming the file:\n%s' % output)
+        self.assertIn('rigid_body_server: cannot load the scene', refusals[0])
+        self.assertIn('no such file', refusals[0])
 
 
 if __name__ == '__main__':

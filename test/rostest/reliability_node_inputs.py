@@ -95,8 +95,8 @@ class NodeInputs(unittest.TestCase):
                         "'<ns>/robot_description' or ~urdf_path")
 
     def test_p08_urdf_path_missing(self):
-        self.expect_refused_start('P08', "cannot load the scene: URDF file '/nonexistent/robot.urdf': cannot be "
-                                  "opened", {'urdf_path': '/nonexistent/robot.urdf'})
+        self.expect_refused_start('P08', "cannot load the scene: URDF file '/nonexistent/robot.urdf': no such file",
+                                  {'urdf_path': '/nonexistent/robot.urdf'})
 
     def test_p09_robot_description_not_text(self):
         self.expect_refused_start('P09', 'cannot load the scene: parameter robot_description: must be a string '

@@ -328,7 +328,7 @@ std::vector<Row> urdfRows()
       load(oneBody(I + collision(meshGeometry("package://nope/meshes/part.stl")))) },
     { "U73", "relative mesh path with no base folder (robot_description)", Expect::Refused, "MeshLoadError",
       "relative path with no base folder", load(oneBody(I + collision(meshGeometry("meshes/part.stl")))) },
-    { "U74", "mesh file that does not exist", Expect::Refused, "MeshLoadError", "cannot be read",
+    { "U74", "mesh file that does not exist", Expect::Refused, "MeshLoadError", "no such file",
       load(oneBody(I + collision(meshGeometry("/nonexistent/part.stl")))) },
     { "U75", "~bodies names an unknown body", Expect::Refused, "SceneDescriptionError",
       "parameter bodies: unknown body 'ghost'",
@@ -409,6 +409,9 @@ std::vector<Row> urdfRows()
       load(robot("<link name=\"a\">" + I + "</link><link name=\"b\">" + I + "</link>" + floatingJoint("a") +
                  joint("fixed", "a", "b") + "<joint name=\"back\" type=\"fixed\"><parent link=\"b\"/>" +
                  "<child link=\"a\"/></joint>")) },
+    { "U89", "package:// mesh whose file does not exist", Expect::Refused, "MeshLoadError",
+      "mesh 'package://diff_rigid_body/test/meshes/no_such_part.stl': mesh '",
+      load(oneBody(I + collision(meshGeometry("package://diff_rigid_body/test/meshes/no_such_part.stl")))) },
   };
   rows.insert(rows.end(), more.begin(), more.end());
   return rows;
