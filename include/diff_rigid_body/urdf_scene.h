@@ -17,6 +17,9 @@
 //   - Links joined to a body by `fixed` joints, directly or transitively, are
 //     merged into it: composite mass, COM and inertia, vertices appended.
 //   - Links fixed to the root are static: no state, published once.
+//   - SceneOptions::floating_base: the root link first becomes the child of
+//     a `floating` joint from a new fixed frame (SceneOptions::fixed_frame,
+//     default "world"), so it and the links below it form one free-rooted body.
 //   - Vertices are the unique positions of the body's geometry in the body
 //     frame (origin at the COM, link axes): the body's own link first, then
 //     merged links in document order; within a link, geometry elements in
@@ -68,8 +71,16 @@ struct SceneOptions
   /// are never read. An unknown name is a load error.
   std::vector<std::string> bodies;
   /// Frame that states and poses are expressed in: the root link or a link
-  /// fixed to it. Empty means the root link.
+  /// fixed to it. Empty means the root link. With floating_base: the name of
+  /// the new frame above the root link, not a link of the URDF; empty means
+  /// "world".
   std::string fixed_frame;
+  /// ~floating_base: the URDF's root link is a free root with the six
+  /// Euler-angle coordinates q = (phi, theta, psi, tx, ty, tz) (t the COM of
+  /// the root link's merged group, in the fixed frame), exactly as if a
+  /// `floating` joint joined it to the fixed frame (for legged and mobile
+  /// robots, whose URDF's root has no parent joint).
+  bool floating_base = false;
   /// Resolves `package://pkg/path` to a file path; throws or returns "" when
   /// the package is unknown. `file://` URIs and absolute paths need no resolver.
   std::function<std::string(const std::string& package)> find_package;

@@ -1,6 +1,8 @@
 #include "urdf_model.h"
 
+#include <memory>
 #include <sstream>
+#include <string>
 #include <utility>
 
 #include <console_bridge/console.h>
@@ -36,6 +38,17 @@ private:
 
 namespace detail
 {
+namespace
+{
+// link_index from link_order.
+void indexLinks(UrdfDescription& description)
+{
+  description.link_index.clear();
+  for (std::size_t i = 0; i < description.link_order.size(); ++i)
+    description.link_index.emplace(description.link_order[i], i);
+}
+}  // namespace
+
 urdf::ModelInterfaceSharedPtr parseUrdfModel(const std::string& urdf_xml)
 {
   CapturedUrdfdomErrors errors;
@@ -89,9 +102,41 @@ UrdfDescription readUrdfDescription(const std::string& urdf_xml, const std::stri
   {
     throw SceneDescriptionError(source + ": " + e.what());
   }
-  for (std::size_t i = 0; i < description.link_order.size(); ++i)
-    description.link_index.emplace(description.link_order[i], i);
+  indexLinks(description);
   return description;
+}
+
+void addFloatingRoot(UrdfDescription& description, const std::string& frame)
+{
+  urdf::ModelInterface& model = *description.model;
+  const urdf::LinkSharedPtr root = model.root_link_;
+  if (model.links_.count(frame))
+    throw SceneDescriptionError("parameter fixed_frame: '" + frame + "' is a link of the URDF" +
+                                (frame == root->name ? " (its root)" : "") +
+                                "; with floating_base the fixed frame is a new frame above the root link '" +
+                                root->name + "': name one that is not a link (~fixed_frame)");
+  std::string joint_name = "floating_base";
+  for (int i = 1; model.joints_.count(joint_name); ++i)
+    joint_name = "floating_base_" + std::to_string(i);
+
+  auto world = std::make_shared<urdf::Link>();
+  world->name = frame;
+  auto joint = std::make_shared<urdf::Joint>();  // origin at the identity, no axis or limits
+  joint->name = joint_name;
+  joint->type = urdf::Joint::FLOATING;
+  joint->parent_link_name = frame;
+  joint->child_link_name = root->name;
+  root->parent_joint = joint;
+  root->setParent(world);
+  world->child_joints.push_back(joint);
+  world->child_links.push_back(root);
+  model.links_[frame] = world;
+  model.joints_[joint_name] = joint;
+  model.root_link_ = world;
+
+  description.link_order.insert(description.link_order.begin(), frame);
+  description.joint_order.insert(description.joint_order.begin(), joint_name);
+  indexLinks(description);
 }
 
 bool movesOneCoordinate(int joint_type)

@@ -46,6 +46,14 @@ struct UrdfDescription
 /// "URDF file '/path/robot.urdf'"), then what is wrong and where.
 UrdfDescription readUrdfDescription(const std::string& urdf_xml, const std::string& source);
 
+/// ~floating_base: makes the root link the child of a new link `frame` through
+/// a `floating` joint at the identity (named "floating_base", or
+/// "floating_base_<i>" when the URDF has a joint of that name), as a
+/// hand-written `<link name="frame"/>` and `<joint type="floating">` first in
+/// the document would. Throws SceneDescriptionError when `frame` is already a
+/// link of the description.
+void addFloatingRoot(UrdfDescription& description, const std::string& frame);
+
 /// Revolute, continuous and prismatic joints: one coordinate each.
 bool movesOneCoordinate(int joint_type);
 

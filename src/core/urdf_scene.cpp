@@ -96,7 +96,9 @@ namespace
 // `source` names the description in error messages: "robot description" or "URDF file '<path>'".
 Scene loadScene(const std::string& urdf_xml, const SceneOptions& options, const std::string& source)
 {
-  const UrdfDescription description = detail::readUrdfDescription(urdf_xml, source);
+  UrdfDescription description = detail::readUrdfDescription(urdf_xml, source);
+  if (options.floating_base)
+    detail::addFloatingRoot(description, options.fixed_frame.empty() ? "world" : options.fixed_frame);
   if (options.density && !(std::isfinite(*options.density) && *options.density > 0.0))
   {
     std::ostringstream why;

@@ -76,6 +76,8 @@ drb::SceneOptions readSceneOptions(const ros::NodeHandle& private_nh)
   else if (joints != "model")
     throw drb::SceneDescriptionError("parameter ~joints: must be 'model' or 'free', got '" + joints + "'");
   options.fixed_frame = private_nh.param<std::string>("fixed_frame", "");
+  if (!private_nh.getParam("floating_base", options.floating_base) && private_nh.hasParam("floating_base"))
+    throw drb::SceneDescriptionError("parameter ~floating_base: must be true or false");
   options.find_package = findPackage;
   return options;
 }

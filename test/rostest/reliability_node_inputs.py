@@ -117,6 +117,10 @@ class NodeInputs(unittest.TestCase):
     def test_p13_threads_zero(self):
         self.expect_serving('P13', '', {'threads': 0})
 
+    def test_p14_floating_base_not_a_bool(self):
+        self.expect_refused_start('P14', 'cannot load the scene: parameter ~floating_base: must be true or false',
+                                  {'floating_base': 'yes'})
+
     # --- ROS transport and topics -------------------------------------------
 
     def raw_jacobians(self, node, request, declared_length=None):

@@ -115,6 +115,13 @@ std::function<std::string()> load(const std::string& xml, drb::SceneOptions opti
   };
 }
 
+drb::SceneOptions floatingBase()
+{
+  drb::SceneOptions options = withPackages();
+  options.floating_base = true;
+  return options;
+}
+
 drb::SceneOptions strict()
 {
   drb::SceneOptions options = withPackages();
@@ -412,6 +419,9 @@ std::vector<Row> urdfRows()
     { "U89", "package:// mesh whose file does not exist", Expect::Refused, "MeshLoadError",
       "mesh 'package://diff_rigid_body/test/meshes/no_such_part.stl': mesh '",
       load(oneBody(I + collision(meshGeometry("package://diff_rigid_body/test/meshes/no_such_part.stl")))) },
+    { "U90", "~floating_base with the fixed frame a link of the URDF (default 'world', its root here)",
+      Expect::Refused, "SceneDescriptionError", "parameter fixed_frame: 'world' is a link of the URDF (its root)",
+      load(oneBody(I), floatingBase()) },
   };
   rows.insert(rows.end(), more.begin(), more.end());
   return rows;
