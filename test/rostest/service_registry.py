@@ -14,10 +14,13 @@ everything that must agree with it (service_registry.test):
   service that is not in the registry), a row for each Python method in the
   Python client's method table and one for each C++ method in the C++ one.
 A service without a client method (`none`) must be benchmark-only.
+GetBodies.srv and BodyState.msg comment every field in the user's terms, `rossrv show -r` prints the
+comments, and README.md names that command.
 """
 import inspect
 import os
 import re
+import subprocess
 import time
 import unittest
 
@@ -183,6 +186,36 @@ class ServiceRegistry(unittest.TestCase):
                 if e[side] != 'none':
                     self.assertIn(e[side], rows, 'README.md, %s: no method-table row for %s() (service %s)'
                                   % (heading, e[side], e['name']))
+
+    def test_field_comments_say_what_fields_mean(self):
+        """GetBodies.srv's response and BodyState.msg comment every field, in the user's terms, and
+        `rossrv show -r` (which the README names; plain `rossrv show` strips comments) prints them."""
+        wanted = {
+            ('srv', 'GetBodies'): {'names': ['root link'], 'masses': ['total'],
+                                   'inertias': ["root link's group", 'about its own COM'],
+                                   'com_offsets': ["root link's group", 'root link frame']},
+            ('msg', 'BodyState'): {'name': ['root link'], 'q': []},
+        }
+        for (kind, name), phrases in wanted.items():
+            text = read(kind, name + '.' + kind)
+            fields = text.split('---')[-1] if kind == 'srv' else text
+            for line in fields.splitlines():
+                if line.strip() and not line.startswith('#') and line.split()[1] not in ('success', 'message'):
+                    self.assertIn('#', line, '%s/%s.%s: field without a comment: %s' % (kind, name, kind, line))
+            for field, fragments in phrases.items():
+                line = next(l for l in fields.splitlines() if re.match(r'^\S+\s+%s\b' % field, l))
+                for fragment in fragments:
+                    self.assertIn(fragment, line, '%s.%s, field %s: its comment should say %r'
+                                  % (name, kind, field, fragment))
+            shown = subprocess.run(['ros%s' % kind, 'show', '-r', '%s/%s' % (PKG, name)], stdout=subprocess.PIPE,
+                                   universal_newlines=True, check=True).stdout
+            self.assertIn(text.strip().splitlines()[0], shown, 'ros%s show -r does not print the comments' % kind)
+        body_state = read('msg', 'BodyState.msg')
+        for fragment in ('CENTRE OF MASS', 'fixed frame', 'NOT of the root', 'com_offsets'):
+            self.assertIn(fragment, body_state, 'BodyState.msg: a free body\'s t should be explained: %r' % fragment)
+        readme = read('README.md')
+        for command in ('rossrv show -r diff_rigid_body/GetBodies', 'rosmsg show -r diff_rigid_body/BodyState'):
+            self.assertIn(command, readme, 'README.md does not show `%s`' % command)
 
 
 if __name__ == '__main__':
