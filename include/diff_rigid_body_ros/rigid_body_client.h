@@ -40,6 +40,7 @@
 #include <diff_rigid_body/SetState.h>
 
 #include "diff_rigid_body_ros/client_arrays.h"
+#include "diff_rigid_body_ros/client_names.h"
 #include "diff_rigid_body_ros/client_requests.h"
 #include "diff_rigid_body_ros/client_responses.h"
 
@@ -49,7 +50,8 @@ class RigidBodyClient
 {
 public:
   /// \param server   the node's name, resolved in nh's namespace (default "rigid_body_server").
-  /// \param timeout  how long to wait for a service when connecting or reconnecting.
+  /// \param timeout  how long to wait for a service when connecting or reconnecting; then
+  ///                 ConnectionError says whether a node of that name runs ("no node at NAME ...").
   explicit RigidBodyClient(const ros::NodeHandle& nh = ros::NodeHandle(),
                            const std::string& server = "rigid_body_server",
                            ros::Duration timeout = ros::Duration(30.0))
@@ -269,8 +271,7 @@ private:
   {
     const std::string name = server_ + "/" + service;
     if (!ros::service::waitForService(name, timeout_))
-      throw ConnectionError("service " + name + " is not advertised (waited " + std::to_string(timeout_.toSec()) +
-                            " s)");
+      throw ConnectionError(detail::missingNodeMessage(server_, name, timeout_.toSec()));
     client = nh_.serviceClient<Service>(name, /*persistent=*/true);
   }
 

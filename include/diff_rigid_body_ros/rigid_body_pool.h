@@ -44,19 +44,20 @@ namespace diff_rigid_body_ros
 class RigidBodyPool
 {
 public:
-  /// `namespaces`: the instances' namespaces, e.g. {"/pool1", "/pool2"} (node <ns>/<options.server>),
-  /// resolved in nh's namespace; the same namespace twice opens two connections to one node.
+  /// `namespaces`: the instances, each a namespace, e.g. {"/pool1", "/pool2"} (node
+  /// <ns>/<options.server>), or a node name, e.g. "/pool1/rigid_body_server" (an entry whose last
+  /// name is options.server), resolved in nh's namespace; the same node twice opens two connections.
   explicit RigidBodyPool(const std::vector<std::string>& namespaces, PoolOptions options = PoolOptions(),
                          const ros::NodeHandle& nh = ros::NodeHandle())
     : shared_(std::make_shared<pool::Shared>())
   {
     if (namespaces.empty())
-      throw std::invalid_argument("RigidBodyPool: at least one namespace");
+      throw std::invalid_argument("RigidBodyPool: at least one namespace or node name");
     if (!options.log)
       options.log = [](const std::string& text) { ROS_WARN_STREAM(text); };
     shared_->options = std::move(options);
-    for (const std::string& ns : namespaces)
-      instances_.push_back(std::make_shared<pool::Instance>(nh, ns + "/" + shared_->options.server,
+    for (const std::string& entry : namespaces)
+      instances_.push_back(std::make_shared<pool::Instance>(nh, detail::poolNodeName(entry, shared_->options.server),
                                                             ros::Duration(shared_->options.probe_timeout)));
     checkScenes();
   }
@@ -164,7 +165,8 @@ private:
         try
         {
           if (!ros::service::waitForService(instance->server + "/get_bodies", ros::Duration(timeout)))
-            throw ConnectionError("get_bodies is not advertised (waited " + std::to_string(timeout) + " s)");
+            throw ConnectionError(detail::missingNodeMessage(instance->server, instance->server + "/get_bodies",
+                                                             timeout));
           instance->client.call("get_bodies", piece.first);
         }
         catch (...)

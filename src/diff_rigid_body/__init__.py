@@ -15,8 +15,8 @@ beside these modules (catkin merges them).
 
 
 def __getattr__(name):
-    if name in ('RigidBodyClient', 'DiffRigidBodyError', 'Bodies', 'MassMatrices', 'InverseDynamicsResult',
-                'ForwardDynamicsResult'):
+    if name in ('RigidBodyClient', 'DiffRigidBodyError', 'NodeNotFoundError', 'Bodies', 'MassMatrices',
+                'InverseDynamicsResult', 'ForwardDynamicsResult'):
         from diff_rigid_body import client
         return getattr(client, name)
     if name in ('RigidBodyPool', 'PoolError'):

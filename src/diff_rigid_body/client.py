@@ -51,6 +51,10 @@ With ``reconnect=False`` the call raises instead (one of
 :data:`CONNECTION_ERRORS`): :class:`~diff_rigid_body.pool.RigidBodyPool`
 sends the work to another instance at once.
 
+A ``bodies`` argument given as one string is one body (``mass_matrix('knot')``);
+a vertex index that is negative or not a whole number raises ValueError
+before anything is sent.
+
 A client is not thread-safe (persistent connections are not): use one per
 thread.
 """
@@ -62,6 +66,7 @@ from rospy.numpy_msg import numpy_msg
 
 from diff_rigid_body.client_arrays import (AnswerShape, floats, indices, optional_values, vertex_blocks,
                                           vertex_configurations, wire_message)
+from diff_rigid_body.client_names import NodeNotFoundError, body_names, missing_node_message
 from diff_rigid_body.client_types import (Bodies, DiffRigidBodyError, ForwardDynamicsResult,
                                          InverseDynamicsResult, Joint, Link, MassMatrices, bodies_from_response)
 from diff_rigid_body.msg import BodyState
@@ -70,7 +75,7 @@ from diff_rigid_body.srv import (Backprop, ForwardDynamics, GetBodies, GetMassMa
 from diff_rigid_body.tcpros import ServiceConnection
 
 __all__ = ['DiffRigidBodyError', 'RigidBodyClient', 'Bodies', 'Joint', 'Link', 'MassMatrices', 'InverseDynamicsResult',
-           'ForwardDynamicsResult', 'CONNECTION_ERRORS']
+           'ForwardDynamicsResult', 'CONNECTION_ERRORS', 'NodeNotFoundError']
 
 #: What a call raises when the node cannot be reached or the connection drops (not a refusal).
 CONNECTION_ERRORS = (rospy.ServiceException, rospy.ROSException, rospy.exceptions.TransportException, OSError)
@@ -94,7 +99,9 @@ class RigidBodyClient(object):
         lands in the caller's namespace), e.g. ``/rigid_body_server`` or
         ``/robot1/rigid_body_server``.
     :param timeout: [s] how long to wait for a service when connecting or
-        reconnecting.
+        reconnecting; then :class:`NodeNotFoundError` says whether a node of
+        that name runs (e.g. ``no node at /rigid_body_srever (is it running?
+        rosnode list): ...``).
     :param reconnect: reconnect once and retry when a connection drops
         (False: raise at once).
     :param transport: ``'tcpros'`` (:class:`~diff_rigid_body.tcpros.ServiceConnection`: the
@@ -131,7 +138,12 @@ class RigidBodyClient(object):
         proxy = self._proxies.get(name)
         if proxy is None:
             resolved = '%s/%s' % (self.server, name)
-            rospy.wait_for_service(resolved, timeout=self.timeout)
+            try:
+                rospy.wait_for_service(resolved, timeout=self.timeout)
+            except rospy.ROSInterruptException:
+                raise
+            except rospy.ROSException:
+                raise NodeNotFoundError(missing_node_message(self.server, resolved, self.timeout)) from None
             if self.transport == 'tcpros':
                 proxy = ServiceConnection(resolved, self.SERVICES[name], self.timeout)
             else:
@@ -206,7 +218,7 @@ class RigidBodyClient(object):
 
     def get_state(self, bodies=None):
         """dict body name -> x (d,), in the node's order (``bodies`` None = all)."""
-        r = self.call('get_state', bodies=list(bodies or []))
+        r = self.call('get_state', bodies=body_names(bodies))
         return collections.OrderedDict((s.name, np.asarray(s.q)) for s in r.states)
 
     def set_state(self, states):
@@ -227,7 +239,7 @@ class RigidBodyClient(object):
         bodies' d differ, M and dM are lists with one array per body, without
         the body axis: ``M[i]`` (d_i, d_i) or (K, d_i, d_i).
         """
-        r = self.call('get_mass_matrix', bodies=list(bodies or []), q=optional_values(q),
+        r = self.call('get_mass_matrix', bodies=body_names(bodies), q=optional_values(q),
                       derivatives=bool(derivatives))
         shape = AnswerShape(r, q)
         return MassMatrices(list(r.bodies), shape.field(r.mass_matrices, 2), shape.field(r.derivatives, 3, derivatives),
@@ -247,7 +259,7 @@ class RigidBodyClient(object):
         ``coriolis_matrices`` adds C (c = C x'), ``derivatives`` dtau/dx and
         dtau/dx' (= 2 C). The node's state is not changed.
         """
-        r = self.call('inverse_dynamics', bodies=list(bodies or []), q=optional_values(q),
+        r = self.call('inverse_dynamics', bodies=body_names(bodies), q=optional_values(q),
                       qdot=optional_values(qdot), qddot=optional_values(qddot),
                       coriolis_matrices=bool(coriolis_matrices), derivatives=bool(derivatives))
         shape = AnswerShape(r, q)
@@ -269,7 +281,7 @@ class RigidBodyClient(object):
         coordinate that moves no mass) raises :class:`DiffRigidBodyError`
         naming the body and the configuration. The node's state is not changed.
         """
-        r = self.call('forward_dynamics', bodies=list(bodies or []), q=optional_values(q),
+        r = self.call('forward_dynamics', bodies=body_names(bodies), q=optional_values(q),
                       qdot=optional_values(qdot), tau=optional_values(tau), derivatives=bool(derivatives))
         shape = AnswerShape(r, q)
         return ForwardDynamicsResult(list(r.bodies), shape.field(r.qddot, 1),

@@ -11,6 +11,8 @@ writes with one copy instead of packing a Python list element by element.
 """
 import numpy as np
 
+_UINT32_MAX = np.iinfo(np.uint32).max
+
 #: numpy dtype (little-endian, as ROS serialises) of each numeric array slot type.
 WIRE_DTYPES = {'float64[]': '<f8', 'float32[]': '<f4', 'uint32[]': '<u4', 'int32[]': '<i4'}
 
@@ -55,8 +57,23 @@ def floats(values):
 
 
 def indices(vertices):
-    """A uint32[] request field of vertex indices: empty (all vertices) for None."""
-    return wire_array([] if vertices is None else vertices, '<u4')
+    """A uint32[] request field of vertex indices: empty (all vertices) for None. An index that is
+    negative, not a whole number or beyond uint32 raises ValueError naming it (numpy would wrap -1
+    to 4294967295, which the node could only call out of range)."""
+    if vertices is None:
+        return wire_array([], '<u4')
+    flat = np.asarray(vertices).reshape(-1)
+    if flat.dtype.kind in 'ui':
+        bad = (flat < 0) | (flat > _UINT32_MAX)
+    elif flat.dtype.kind == 'f':
+        bad = ~np.isfinite(flat) | (flat != np.floor(flat)) | (flat < 0) | (flat > _UINT32_MAX)
+    else:
+        bad = np.ones(flat.shape, dtype=bool)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise ValueError("vertices[%d]: %r is not a vertex index: a whole number from 0 to N - 1 (the body's vertex "
+                         "count - 1); a negative index does not count from the end" % (i, flat[i].item()))
+    return wire_array(flat, '<u4')
 
 
 def optional_values(values):

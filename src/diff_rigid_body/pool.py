@@ -1,6 +1,6 @@
 """A pool of rigid_body_server instances serving the same scene, used as one client.
 
-``RigidBodyPool(['/a', '/b'])`` has every method of
+``RigidBodyPool(['/a', '/b'])`` (namespaces, or node names such as ``'/a/rigid_body_server'``) has every method of
 :class:`~diff_rigid_body.client.RigidBodyClient` (numpy arrays, the same shapes). A call of K > 1
 configurations to ``mass_matrix``, ``vertex_jacobians``, ``vertex_jacobians_compact``,
 ``positions``, ``backprop``, ``inverse_dynamics`` or ``forward_dynamics`` is cut into contiguous
@@ -32,6 +32,7 @@ import numpy as np
 import rospy
 
 from diff_rigid_body.client import CONNECTION_ERRORS, DiffRigidBodyError, RigidBodyClient
+from diff_rigid_body.client_names import body_names, pool_node_name
 from diff_rigid_body.pool_shards import JoinedResponse, apportion, configuration_count, shard_message
 from diff_rigid_body.pool_threads import Worker, wait_all
 
@@ -103,8 +104,9 @@ class _Instance(object):
 class RigidBodyPool(RigidBodyClient):
     """Several instances of rigid_body_server used as one :class:`RigidBodyClient`.
 
-    :param namespaces: the instances' namespaces, e.g. ``['/a', '/b']`` (the node
-        ``<namespace>/<server>`` of each); the same namespace twice opens two connections to one node.
+    :param namespaces: the instances, each a namespace, e.g. ``'/a'`` (the node
+        ``<namespace>/<server>``), or a node name, e.g. ``'/a/rigid_body_server'`` (an entry whose last
+        name is ``server``); one string is one instance. The same node twice opens two connections to it.
     :param server: the node's name within each namespace.
     :param timeout: [s] how long to wait for each instance at the start.
     :param call_timeout: [s] an instance with no answer by then is down and its shard goes elsewhere.
@@ -115,9 +117,9 @@ class RigidBodyPool(RigidBodyClient):
 
     def __init__(self, namespaces, server='rigid_body_server', timeout=30.0, call_timeout=30.0, retry_interval=5.0,
                  probe_timeout=2.0, log=None):
-        names = [rospy.resolve_name('%s/%s' % (namespace.rstrip('/'), server)) for namespace in namespaces]
+        names = [pool_node_name(entry, server) for entry in body_names(namespaces)]
         if not names:
-            raise ValueError('RigidBodyPool: at least one namespace')
+            raise ValueError('RigidBodyPool: at least one namespace or node name')
         # RigidBodyClient's state, without its connections: the instances' clients hold those.
         self.server, self.timeout, self.reconnect, self._proxies = 'pool(%s)' % ', '.join(names), timeout, False, {}
         self.call_timeout, self.retry_interval, self.probe_timeout = call_timeout, retry_interval, probe_timeout

@@ -120,6 +120,22 @@ TEST(CppClient, RefusalThrowsServiceErrorWithTheNodesMessage)
   EXPECT_EQ(client.bodies().names.size(), 2u);
 }
 
+TEST(CppClient, AWrongNodeNameSaysNoNodeThere)
+{
+  RigidBodyClient client(ros::NodeHandle(), "/rigid_body_srever", ros::Duration(1.0));
+  try
+  {
+    client.bodies();
+    FAIL() << "no exception";
+  }
+  catch (const diff_rigid_body_ros::ConnectionError& e)
+  {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("no node at /rigid_body_srever (is it running? rosnode list)"), std::string::npos) << what;
+    EXPECT_NE(what.find("/rigid_body_srever/get_bodies"), std::string::npos) << what;
+  }
+}
+
 TEST(CppClient, GaussNewtonRecoversAHiddenPose)
 {
   RigidBodyClient client;

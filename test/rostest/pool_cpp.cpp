@@ -188,6 +188,35 @@ TEST(RigidBodyPool, NoInstanceIsAClearError)
   }
 }
 
+TEST(RigidBodyPool, TakesNamespacesOrNodeNames)
+{
+  std::vector<std::string> log;
+  drb::PoolOptions options = quietOptions(&log);
+  options.timeout = 10.0;
+  drb::RigidBodyPool pool({ "/pool1/rigid_body_server", "/pool2" }, options);
+  const std::vector<drb::InstanceStatus> status = pool.status();
+  ASSERT_EQ(status.size(), 2u);
+  EXPECT_EQ(status[0].server, "/pool1/rigid_body_server");
+  EXPECT_EQ(status[1].server, "/pool2/rigid_body_server");
+  EXPECT_TRUE(status[0].up && status[1].up) << status[0].failure << status[1].failure;
+}
+
+TEST(RigidBodyPool, AClientGivenANamespaceNamesTheNodeBelowIt)
+{
+  drb::RigidBodyClient client(ros::NodeHandle(), "/pool1", ros::Duration(1.0));
+  try
+  {
+    client.bodies();
+    FAIL() << "a client of a namespace answered";
+  }
+  catch (const drb::ConnectionError& e)
+  {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("no node at /pool1"), std::string::npos) << what;
+    EXPECT_NE(what.find("below /pool1 there is /pool1/rigid_body_server"), std::string::npos) << what;
+  }
+}
+
 // Last. /pool2 respawns (a rostest may not lose a required node), but stays out of this pool until
 // its retry time (5 s).
 TEST(RigidBodyPool, InstanceKilledMidCallChangesNothing)
