@@ -42,6 +42,19 @@ std::vector<double> flatten(const std::vector<Vector>& qs)
   return q;
 }
 
+/// flatten, or empty (zeros, or the current state) for no configuration.
+template <typename Vector>
+std::vector<double> flattenOptional(const std::vector<Vector>& qs)
+{
+  return qs.empty() ? std::vector<double>() : flatten(qs);
+}
+
+/// Enables an overload for Eigen vectors (Vector6d, Eigen::VectorXd, ...), as template parameter
+/// `detail::IfEigenVector<Vector> = 0`: a flat std::vector<double> or a braced list keeps the
+/// overload that takes std::vector<double>.
+template <typename Vector>
+using IfEigenVector = std::enable_if_t<std::is_base_of<Eigen::MatrixBase<Vector>, Vector>::value, int>;
+
 /// dL/dp blocks (3 x N each, one per configuration) as a backprop request's gradients field
 /// (K x N x 3, configuration-major).
 inline std::vector<double> flattenGradients(const std::vector<const Eigen::Matrix3Xd*>& dL_dp)

@@ -12,6 +12,7 @@
 #include <diff_rigid_body/GetBodies.h>
 #include <diff_rigid_body/GetMassMatrix.h>
 #include <diff_rigid_body/GetVertexJacobians.h>
+#include <diff_rigid_body/GetVertexJacobiansCompact.h>
 #include <diff_rigid_body/InverseDynamics.h>
 
 #include "diff_rigid_body_ros/client_arrays.h"
@@ -159,6 +160,27 @@ inline std::vector<VertexJacobians> toVertexJacobians(const diff_rigid_body::Get
   {
     out[k].positions = Eigen::Map<const Eigen::Matrix3Xd>(r.positions.data() + 3 * n * k, 3, n);
     out[k].J = Eigen::Map<const StackedJacobians>(r.jacobians.data() + 3 * n * d * k, 3 * n, d);
+  }
+  return out;
+}
+
+/// get_vertex_jacobians_compact of K configurations in Scalar (double, or float for the float32
+/// fields): one block of positions and Jr per configuration (Jr with 0 rows for `positions_only`).
+template <typename Scalar>
+std::vector<VertexRotationJacobians<Scalar>> toRotationJacobians(
+    const diff_rigid_body::GetVertexJacobiansCompact::Response& r, std::size_t K, bool positions_only)
+{
+  const std::vector<Scalar>& positions = detail::compactField<Scalar>(r.positions, r.positions_f32);
+  const std::vector<Scalar>& jacobians = detail::compactField<Scalar>(r.rotation_jacobians, r.rotation_jacobians_f32);
+  const Eigen::Index n = detail::vertexCount(positions.size(), K);
+  const Eigen::Index rows = positions_only ? 0 : 3 * n;
+  const Eigen::Index columns = rows ? static_cast<Eigen::Index>(jacobians.size() / (rows * K)) : 0;
+  std::vector<VertexRotationJacobians<Scalar>> out(K);
+  for (std::size_t k = 0; k < K; ++k)
+  {
+    out[k].positions = Eigen::Map<const Eigen::Matrix<Scalar, 3, Eigen::Dynamic>>(positions.data() + 3 * n * k, 3, n);
+    out[k].Jr = Eigen::Map<const typename VertexRotationJacobians<Scalar>::StackedRotationJacobians>(
+        jacobians.data() + rows * columns * k, rows, columns);
   }
   return out;
 }

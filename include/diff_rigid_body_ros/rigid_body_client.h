@@ -40,13 +40,14 @@
 #include <diff_rigid_body/SetState.h>
 
 #include "diff_rigid_body_ros/client_arrays.h"
+#include "diff_rigid_body_ros/client_batches.h"
 #include "diff_rigid_body_ros/client_names.h"
 #include "diff_rigid_body_ros/client_requests.h"
 #include "diff_rigid_body_ros/client_responses.h"
 
 namespace diff_rigid_body_ros
 {
-class RigidBodyClient
+class RigidBodyClient : public EigenBatches<RigidBodyClient>
 {
 public:
   /// \param server   the node's name, resolved in nh's namespace (default "rigid_body_server").
@@ -102,6 +103,7 @@ public:
     call("get_mass_matrix", srv);
     return toMassMatrices(srv.response, derivatives);
   }
+  using EigenBatches<RigidBodyClient>::massMatrices;  // K configurations as std::vector<Vector6d or VectorXd>
 
   /// M of one body at x (one configuration): d x d.
   template <typename Derived>
@@ -123,6 +125,7 @@ public:
     call("inverse_dynamics", srv);
     return toInverseDynamics(srv.response);
   }
+  using EigenBatches<RigidBodyClient>::inverseDynamics;
   /// One body at one configuration (any Eigen vectors of its d coordinates).
   template <typename Q, typename Qdot, typename Qddot>
   InverseDynamicsResult inverseDynamics(const std::string& body, const Eigen::MatrixBase<Q>& x,
@@ -145,6 +148,7 @@ public:
     call("forward_dynamics", srv);
     return toForwardDynamics(srv.response);
   }
+  using EigenBatches<RigidBodyClient>::forwardDynamics;
   /// One body at one configuration (any Eigen vectors of its d coordinates).
   template <typename Q, typename Qdot, typename Tau>
   ForwardDynamicsResult forwardDynamics(const std::string& body, const Eigen::MatrixBase<Q>& x,
@@ -338,20 +342,7 @@ private:
     srv.request.positions_only = positions_only;
     srv.request.single_precision = std::is_same<Scalar, float>::value;
     call("get_vertex_jacobians_compact", srv);
-    const auto& r = srv.response;
-    const std::vector<Scalar>& positions = detail::compactField<Scalar>(r.positions, r.positions_f32);
-    const std::vector<Scalar>& jacobians = detail::compactField<Scalar>(r.rotation_jacobians, r.rotation_jacobians_f32);
-    const Eigen::Index n = detail::vertexCount(positions.size(), K);
-    const Eigen::Index rows = positions_only ? 0 : 3 * n;
-    const Eigen::Index columns = rows ? static_cast<Eigen::Index>(jacobians.size() / (rows * K)) : 0;
-    std::vector<VertexRotationJacobians<Scalar>> out(K);
-    for (std::size_t k = 0; k < K; ++k)
-    {
-      out[k].positions = Eigen::Map<const Eigen::Matrix<Scalar, 3, Eigen::Dynamic>>(positions.data() + 3 * n * k, 3, n);
-      out[k].Jr = Eigen::Map<const typename VertexRotationJacobians<Scalar>::StackedRotationJacobians>(
-          jacobians.data() + rows * columns * k, rows, columns);
-    }
-    return out;
+    return toRotationJacobians<Scalar>(srv.response, K, positions_only);
   }
 
   ros::NodeHandle nh_;

@@ -33,6 +33,7 @@
 
 #include <ros/ros.h>
 
+#include "diff_rigid_body_ros/client_batches.h"
 #include "diff_rigid_body_ros/client_requests.h"
 #include "diff_rigid_body_ros/client_responses.h"
 #include "diff_rigid_body_ros/pool_shards.h"
@@ -41,7 +42,7 @@
 
 namespace diff_rigid_body_ros
 {
-class RigidBodyPool
+class RigidBodyPool : public EigenBatches<RigidBodyPool>
 {
 public:
   /// `namespaces`: the instances, each a namespace, e.g. {"/pool1", "/pool2"} (node
@@ -73,7 +74,8 @@ public:
     call(srv);
     return toMassMatrices(srv.response, derivatives);
   }
-  /// As RigidBodyClient::inverseDynamics.
+  using EigenBatches<RigidBodyPool>::massMatrices;  // K configurations as std::vector<Vector6d or VectorXd>
+  /// As RigidBodyClient::inverseDynamics (flat q, or one Eigen vector per configuration).
   InverseDynamicsResult inverseDynamics(const std::vector<double>& q, const std::vector<double>& qdot = {},
                                         const std::vector<double>& qddot = {},
                                         const std::vector<std::string>& bodies = {}, bool coriolis_matrices = false,
@@ -83,7 +85,8 @@ public:
     call(srv);
     return toInverseDynamics(srv.response);
   }
-  /// As RigidBodyClient::forwardDynamics.
+  using EigenBatches<RigidBodyPool>::inverseDynamics;
+  /// As RigidBodyClient::forwardDynamics (flat q, or one Eigen vector per configuration).
   ForwardDynamicsResult forwardDynamics(const std::vector<double>& q, const std::vector<double>& qdot = {},
                                         const std::vector<double>& tau = {},
                                         const std::vector<std::string>& bodies = {}, bool derivatives = false)
@@ -92,25 +95,40 @@ public:
     call(srv);
     return toForwardDynamics(srv.response);
   }
-  /// As RigidBodyClient::vertexJacobians with K configurations: block k for qs[k].
+  using EigenBatches<RigidBodyPool>::forwardDynamics;
+
+  /// As RigidBodyClient::vertexJacobians with K configurations: block k for qs[k] (Vector6d or VectorXd).
   std::vector<VertexJacobians> vertexJacobians(const std::string& body, const std::vector<Eigen::VectorXd>& qs,
+                                               const std::vector<std::uint32_t>& vertices = {})
+  {
+    return vertexJacobians<Eigen::VectorXd>(body, qs, vertices);
+  }
+  template <typename Vector, detail::IfEigenVector<Vector> = 0>
+  std::vector<VertexJacobians> vertexJacobians(const std::string& body, const std::vector<Vector>& qs,
                                                const std::vector<std::uint32_t>& vertices = {})
   {
     auto srv = detail::vertexJacobiansRequest(body, vertices, detail::flatten(qs));
     call(srv);
     return toVertexJacobians(srv.response, qs.size());
   }
-  /// As RigidBodyClient::backprop with K configurations: dL/dx at qs[k] from dL_dp[k] (3 x N).
+  /// As RigidBodyClient::backprop with K configurations: dL/dx at qs[k] from dL_dp[k] (3 x N), as qs' type.
   std::vector<Eigen::VectorXd> backprop(const std::string& body, const std::vector<Eigen::Matrix3Xd>& dL_dp,
                                         const std::vector<Eigen::VectorXd>& qs,
                                         const std::vector<std::uint32_t>& vertices = {})
+  {
+    return backprop<Eigen::VectorXd>(body, dL_dp, qs, vertices);
+  }
+  template <typename Vector, detail::IfEigenVector<Vector> = 0>
+  std::vector<Vector> backprop(const std::string& body, const std::vector<Eigen::Matrix3Xd>& dL_dp,
+                               const std::vector<Vector>& qs, const std::vector<std::uint32_t>& vertices = {})
   {
     if (dL_dp.size() != qs.size())
       throw std::invalid_argument("backprop: " + std::to_string(dL_dp.size()) + " gradient blocks for " +
                                   std::to_string(qs.size()) + " configurations");
     auto srv = detail::backpropRequest(body, vertices, detail::flattenGradients(dL_dp), detail::flatten(qs));
     call(srv);
-    return toGradients(srv.response, qs.size());
+    const std::vector<Eigen::VectorXd> out = toGradients(srv.response, qs.size());
+    return std::vector<Vector>(out.begin(), out.end());
   }
 
   /// Any sharded service (pool_shards.h: Sharding<Service>): srv.response is the joined answer.

@@ -76,6 +76,44 @@ TEST(CppClient, BatchedMassMatricesMatchSingleCallsAndLayout)
     }
 }
 
+TEST(CppClient, BatchedCallsTakeOneEigenVectorPerConfiguration)
+{
+  // massMatrices, inverseDynamics and forwardDynamics take std::vector<Vector6d> (or VectorXd), as
+  // vertexJacobians and backprop do: the same answer, bit for bit, as K configurations concatenated.
+  RigidBodyClient client;
+  std::vector<Vector6d> qs, qdots;
+  std::vector<Eigen::VectorXd> qs_dynamic;
+  std::vector<double> flat, flat_qdot;
+  for (int k = 0; k < 3; ++k)
+  {
+    Vector6d q, qdot;
+    for (int c = 0; c < 6; ++c)
+      q[c] = 0.1 * (k + 1) * (c + 1), qdot[c] = 0.2 * (c - k);
+    qs.push_back(q), qdots.push_back(qdot), qs_dynamic.push_back(q);
+    flat.insert(flat.end(), q.data(), q.data() + 6);
+    flat_qdot.insert(flat_qdot.end(), qdot.data(), qdot.data() + 6);
+  }
+  const auto M = client.massMatrices({ "knot" }, flat, true);
+  const auto M6 = client.massMatrices({ "knot" }, qs, true), MX = client.massMatrices({ "knot" }, qs_dynamic, true);
+  ASSERT_EQ(M6.configurations, 3u);
+  for (std::size_t k = 0; k < 3; ++k)
+  {
+    EXPECT_EQ(M6.at(k, 0), M.at(k, 0));
+    EXPECT_EQ(MX.at(k, 0), M.at(k, 0));
+    EXPECT_EQ(M6.dM[k][4], M.dM[k][4]);
+  }
+  const auto tau = client.inverseDynamics(flat, flat_qdot, {}, { "knot" });
+  const auto tau6 = client.inverseDynamics(qs, qdots, {}, { "knot" });
+  const auto qddot = client.forwardDynamics(flat, flat_qdot, {}, { "knot" });
+  const auto qddot6 = client.forwardDynamics(qs, qdots, {}, { "knot" });
+  ASSERT_EQ(tau6.tau.size(), 3u);
+  for (std::size_t k = 0; k < 3; ++k)
+  {
+    EXPECT_EQ(tau6.tau[k], tau.tau[k]);
+    EXPECT_EQ(qddot6.qddot[k], qddot.qddot[k]);
+  }
+}
+
 TEST(CppClient, JacobiansMatchFiniteDifferencesAndBackprop)
 {
   RigidBodyClient client;

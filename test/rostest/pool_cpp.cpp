@@ -144,6 +144,28 @@ TEST(RigidBodyPool, AnswersEqualOneInstanceBitForBit)
   EXPECT_TRUE(log.empty()) << log.front();
 }
 
+TEST(RigidBodyPool, BatchedCallsTakeOneEigenVectorPerConfiguration)
+{
+  // As RigidBodyClient: massMatrices, inverseDynamics, forwardDynamics with std::vector<VectorXd>
+  // answer as with the K configurations concatenated, bit for bit.
+  std::vector<std::string> log;
+  drb::RigidBodyPool pool(kPool, quietOptions(&log));
+  const std::vector<Eigen::VectorXd> qs = configurations(6);
+  std::vector<double> flat;
+  for (const Eigen::VectorXd& q : qs)
+    flat.insert(flat.end(), q.data(), q.data() + q.size());
+  const auto M = pool.massMatrices({ kBody }, flat), MX = pool.massMatrices({ kBody }, qs);
+  const auto tau = pool.inverseDynamics(flat), tauX = pool.inverseDynamics(qs);
+  const auto qddot = pool.forwardDynamics(flat, {}, {}, { kBody }), qddotX = pool.forwardDynamics(qs, {}, {}, { kBody });
+  ASSERT_EQ(MX.configurations, qs.size());
+  for (std::size_t k = 0; k < qs.size(); ++k)
+  {
+    EXPECT_EQ(MX.at(k, 0), M.at(k, 0));
+    EXPECT_EQ(tauX.tau[k], tau.tau[k]);
+    EXPECT_EQ(qddotX.qddot[k], qddot.qddot[k]);
+  }
+}
+
 TEST(RigidBodyPool, ApportionFollowsThroughput)
 {
   EXPECT_EQ(drb::pool::apportion(8, { 3.0, 1.0 }), (std::vector<std::size_t>{ 6, 2 }));

@@ -1,5 +1,16 @@
 #!/usr/bin/python3
-"""Runs the `rosservice call` examples of README.md against the running node.
+"""Runs the examples of README.md as written against the running nodes.
+
+~examples selects what this run checks (each in its own test of readme_examples.test):
+
+- "rosservice" (default): the `rosservice call` examples, below.
+- "python": every ```python block marked `<!-- test: readme_examples.py: python -->` runs, each in
+  a fresh namespace (the clients' and the pool's; /rigid_body_server, /pool1 and /pool2 serve the
+  default scene).
+- "cpp_package": the blocks marked `package.xml`, `CMakeLists.txt` and `src/drb_example.cpp`
+  become a catkin package in a temporary workspace; every ```cpp block marked `snippet` is pasted
+  into its main (its #include lines at the top, its statements in a block of their own, in the
+  place of the skeleton's comment line); `catkin_make` builds it and the program must exit 0.
 
 Every ```bash block of README.md that contains `rosservice call` is taken
 (only those of the section under the heading ~section, e.g. "## Robots
@@ -12,8 +23,10 @@ without them must print `success: True`.
 """
 import os
 import re
+import shutil
 import subprocess
 import sys
+import tempfile
 import unittest
 
 import rospy
@@ -75,6 +88,77 @@ def unquote(text):
     return text
 
 
+def marked_blocks(readme_text):
+    """[(label, language, code)] of the fenced blocks right after `<!-- test: readme_examples.py: LABEL -->`."""
+    pattern = r'<!-- test: readme_examples\.py: ([^ ]+) -->\n```(\w+)\n(.*?)```'
+    return re.findall(pattern, readme_text, re.S)
+
+
+def read_readme():
+    with open(os.path.join(rospkg.RosPack().get_path(PKG), 'README.md')) as f:
+        return f.read()
+
+
+def paste_snippets(main, snippets):
+    """`main` with each snippet's #include lines added after its own, and its other lines, in a block
+    of their own, in the place of main's comment line inside main()."""
+    includes, blocks = [], []
+    for snippet in snippets:
+        lines = snippet.splitlines()
+        includes += [line for line in lines if line.startswith('#include') and line not in main]
+        body = [line for line in lines if not line.startswith('#include')]
+        blocks.append('  {\n' + '\n'.join('    ' + line for line in body) + '\n  }')
+    marker = re.search(r'^  // .*\n', main, re.M)
+    if marker is None:
+        raise ValueError('src/drb_example.cpp of README.md has no comment line in main() for the calls')
+    main = main[:marker.start()] + '\n'.join(blocks) + '\n' + main[marker.end():]
+    return '\n'.join(includes) + ('\n' if includes else '') + main
+
+
+class ReadmePythonExamples(unittest.TestCase):
+
+    def test_marked_python_blocks_run(self):
+        blocks = [code for label, language, code in marked_blocks(read_readme()) if label == 'python']
+        self.assertGreaterEqual(len(blocks), 2, 'README.md: the client and pool Python blocks are not marked')
+        for service in ('/rigid_body_server', '/pool1/rigid_body_server', '/pool2/rigid_body_server'):
+            rospy.wait_for_service(service + '/get_bodies', timeout=60.0)
+        for i, code in enumerate(blocks):
+            sys.stdout.write('--- README.md Python block %d ---\n%s\n' % (i, code))
+            exec(compile(code, 'README.md (Python block %d)' % i, 'exec'), {'__name__': 'readme_block'})
+
+
+class ReadmeCppPackage(unittest.TestCase):
+
+    def test_package_builds_and_runs_the_snippets(self):
+        blocks = marked_blocks(read_readme())
+        files = dict((label, code) for label, _, code in blocks
+                     if label in ('package.xml', 'CMakeLists.txt', 'src/drb_example.cpp'))
+        self.assertEqual(len(files), 3, 'README.md: the package files are not all marked: %s' % sorted(files))
+        snippets = [code for label, language, code in blocks if label == 'snippet' and language == 'cpp']
+        self.assertGreaterEqual(len(snippets), 2, 'README.md: the client and pool C++ snippets are not marked')
+        files['src/drb_example.cpp'] = paste_snippets(files['src/drb_example.cpp'], snippets)
+        workspace = tempfile.mkdtemp(prefix='drb_readme_ws_')
+        self.addCleanup(shutil.rmtree, workspace, True)
+        package = os.path.join(workspace, 'src', 'drb_example')
+        for name, text in files.items():
+            os.makedirs(os.path.dirname(os.path.join(package, name)), exist_ok=True)
+            with open(os.path.join(package, name), 'w') as f:
+                f.write(text)
+        sys.stdout.write('--- src/drb_example.cpp as built ---\n%s\n' % files['src/drb_example.cpp'])
+        environment = dict(os.environ, PATH='/usr/bin:/bin:' + os.environ.get('PATH', ''), PWD=workspace)
+        build = subprocess.run(['catkin_make', '-C', workspace, '-j2'], cwd=workspace, env=environment,
+                               stdout=subprocess.PIPE,
+                               stderr=subprocess.STDOUT, universal_newlines=True, timeout=600)
+        self.assertEqual(build.returncode, 0, 'catkin_make of the README package failed:\n%s' % build.stdout[-6000:])
+        for service in ('/rigid_body_server', '/pool1/rigid_body_server', '/pool2/rigid_body_server'):
+            rospy.wait_for_service(service + '/get_bodies', timeout=60.0)
+        run = subprocess.run([os.path.join(workspace, 'devel', 'lib', 'drb_example', 'drb_example')],
+                             env=environment, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                             universal_newlines=True, timeout=120)
+        sys.stdout.write('--- drb_example ---\n%s\n' % run.stdout)
+        self.assertEqual(run.returncode, 0, 'drb_example exited with %d:\n%s' % (run.returncode, run.stdout))
+
+
 class ReadmeExamples(unittest.TestCase):
 
     def test_rosservice_examples_work(self):
@@ -113,4 +197,5 @@ class ReadmeExamples(unittest.TestCase):
 
 if __name__ == '__main__':
     rospy.init_node('readme_examples')
-    rostest.rosrun(PKG, 'readme_examples', ReadmeExamples)
+    CASES = {'rosservice': ReadmeExamples, 'python': ReadmePythonExamples, 'cpp_package': ReadmeCppPackage}
+    rostest.rosrun(PKG, 'readme_examples', CASES[rospy.get_param('~examples', 'rosservice')])
