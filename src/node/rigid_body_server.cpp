@@ -68,6 +68,7 @@ RigidBodyServer::RigidBodyServer(ros::NodeHandle& nh, ros::NodeHandle& private_n
   , state_file_(settings.state_file)
   , frame_prefix_(settings.frame_prefix)
   , state_(std::make_shared<const SceneState>(initialState(queries_, state_file_)))
+  , joint_limit_warnings_(queries_.scene())
 {
   tf_subscriber_counter_ = nh.advertise<tf2_msgs::TFMessage>("/tf", 100);  // as tf2_ros::TransformBroadcaster
   states_publisher_ = private_nh.advertise<BodyStateArray>("states", 10, /*latch=*/true);
@@ -111,6 +112,8 @@ void RigidBodyServer::commit(const std::function<SceneState(const SceneState&)>&
   }
   updateOutgoingMessages(*previous, *next);
   publishState(ros::Time::now(), /*state_changed=*/true);
+  for (const std::string& warning : joint_limit_warnings_.check(*previous, *next))
+    ROS_WARN_STREAM("rigid_body_server: " << warning);
 }
 
 void RigidBodyServer::applyStates(const std::vector<BodyState>& states)

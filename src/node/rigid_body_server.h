@@ -26,7 +26,8 @@
 // State changes come from set_state, ~set_states and joint_states
 // (sensor_msgs/JointState, as robot_state_publisher reads it): each goes
 // through commit(), so each is validated whole, saved, swapped in and
-// published the same way.
+// published the same way, and a joint it puts outside its URDF limits is
+// warned about once (joint_limit_warnings.h).
 #pragma once
 
 #include <functional>
@@ -45,6 +46,7 @@
 
 #include "diff_rigid_body/scene_queries.h"
 #include "diff_rigid_body_ros/services.h"
+#include "joint_limit_warnings.h"
 
 namespace diff_rigid_body
 {
@@ -139,6 +141,8 @@ private:
   ros::Publisher states_publisher_;
   ros::Subscriber set_states_subscriber_;
   ros::Subscriber joint_states_subscriber_;
+  /// Joints of accepted states outside their URDF limits, warned once each (guarded by write_mutex_).
+  JointLimitWarnings joint_limit_warnings_;
   /// Unknown joint names already logged (guarded by write_mutex_).
   std::set<std::string> unknown_joints_logged_;
   /// Distinct unknown joint names logged at most (a hostile publisher cannot grow the set).

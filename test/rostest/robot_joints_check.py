@@ -16,7 +16,8 @@ Checks: (a) after a JointState on joint_states, every link's tf equals the oracl
 (b) get_state returns those joint values bit for bit; (c) J = dp/dx matches central differences
 of positions at x +- h within 1e-6 (relative to max |J|); (d) backprop = J^T g; (e) the UR5's
 M(x) is symmetric positive definite at its home poses; (f) an unknown joint name is ignored and
-logged once, and a message with a NaN position changes nothing.
+logged once, and a message with a NaN position changes nothing; (g) joint_states, set_state and
+~set_states that put a joint outside its URDF <limit> are accepted and warned about once per joint.
 """
 import math
 import sys
@@ -32,6 +33,7 @@ from rosgraph_msgs.msg import Log
 from sensor_msgs.msg import JointState
 
 from diff_rigid_body.client import RigidBodyClient
+from diff_rigid_body.msg import BodyState, BodyStateArray
 
 PKG = 'diff_rigid_body'
 TF_TOLERANCE = 1e-9  # [m], and on rotation matrix entries
@@ -272,6 +274,44 @@ class RobotJoints(unittest.TestCase):
         self.assertEqual(self.rosout.count("'no_such_joint'"), 1, 'the unknown joint is not logged exactly once')
         self.assertGreaterEqual(self.rosout.count("joint '%s'" % self.names[1]), 1,
                                 'the NaN message was dropped without a warning naming %s' % self.names[1])
+
+    def test_g_joints_outside_their_limits_are_accepted_and_warned_once(self):
+        """joint_states, set_state and ~set_states may put a joint outside its URDF <limit>: the state
+        is accepted, and the node warns once per joint, naming the joint, the value and the limits
+        (read here from the URDF's <limit> attributes, as written)."""
+        limits = {j.get('name'): (j.find('limit').get('lower'), j.find('limit').get('upper'))
+                  for j in ET.parse(self.urdf).getroot().findall('joint') if j.find('limit') is not None}
+        setter = rospy.Publisher('/rigid_body_server/set_states', BodyStateArray, queue_size=10)
+        x = self.client.get_state([self.body])[self.body].copy()
+        cases = [('panda_joint1', 3.5, lambda x: self.publish(['panda_joint1'], [x[0]])),
+                 ('panda_joint4', 0.5, lambda x: self.client.set_state({self.body: x})),
+                 ('panda_joint6', -1.25, lambda x: setter.publish(states=[BodyState(name=self.body, q=list(x))]))]
+        deadline = rospy.Time.now() + rospy.Duration(WAIT)
+        while setter.get_num_connections() == 0 and rospy.Time.now() < deadline:
+            rospy.sleep(0.05)
+        for name, value, send in cases:
+            x[self.names.index(name)] = value
+            send(x)
+            self.wait_for_state(x, '%s = %g, outside its limits' % (name, value))
+            lower, upper = limits[name]
+            expected = "joint '%s' of body '%s' at %g is outside its URDF limits [%s, %s]" % (
+                name, self.body, value, lower, upper)
+            deadline = rospy.Time.now() + rospy.Duration(WAIT)
+            while self.rosout.count(expected) < 1 and rospy.Time.now() < deadline:
+                rospy.sleep(0.05)
+            self.assertEqual(self.rosout.count(expected), 1, 'no warning %r' % expected)
+        # Again beyond the same limit: accepted, no second warning (the next joint's warning, which the
+        # node logs after it, shows that the node has handled it).
+        x[0] = 3.75
+        self.publish(['panda_joint1'], [x[0]])
+        self.wait_for_state(x, 'panda_joint1 = 3.75')
+        x[self.names.index('panda_joint2')] = 2.5
+        self.client.set_state({self.body: x})
+        deadline = rospy.Time.now() + rospy.Duration(WAIT)
+        while self.rosout.count("joint 'panda_joint2' of body") < 1 and rospy.Time.now() < deadline:
+            rospy.sleep(0.05)
+        self.assertEqual(self.rosout.count("joint 'panda_joint1' of body"), 1, 'panda_joint1 warned twice')
+        self.assertEqual(self.rosout.count("joint 'panda_joint2' of body"), 1)
 
 
 if __name__ == '__main__':
