@@ -39,6 +39,8 @@ DRB_APT_PACKAGES=(
   # clients and rviz: the Python client, rviz, and the headless screenshot
   # (xvfb-run needs xauth; software OpenGL comes from the Mesa DRI drivers)
   python3-rospy rviz xvfb xauth imagemagick libgl1-mesa-dri
+  # tf from the command line: rosrun tf2_tools echo.py (README; Debian ships no tf_echo)
+  tf2-tools
   # reliability: libFuzzer targets (clang, libFuzzer and the sanitizer
   # runtimes) and symbolised sanitizer reports (scripts/fuzz)
   clang libclang-rt-14-dev llvm

@@ -19,7 +19,8 @@ need their own scene); its commands run in order, through bash, as a reader
 would paste them.
 Comment lines right after a command ("# key: value") are the output the
 README promises: each such key must be printed with that value. A command
-without them must print `success: True`.
+without them must print `success: True`. After a command that is not a
+`rosservice call`, "# prints: TEXT" says that its output contains TEXT.
 """
 import os
 import re
@@ -181,6 +182,9 @@ class ReadmeExamples(unittest.TestCase):
             sys.stdout.write('$ %s\n%s\n' % (command, shown))
             self.assertEqual(run.returncode, 0, '`%s` exited with %d:\n%s' % (command, run.returncode, output))
             if not command.startswith('rosservice call'):
+                for key, value in expected:  # "# prints: TEXT": the output holds TEXT
+                    self.assertEqual(key, 'prints', '`%s`: only "# prints: ..." may follow it' % command)
+                    self.assertIn(value, output, '`%s` did not print %r:\n%s' % (command, value, output))
                 continue
             printed = {}
             for line in output.splitlines():
