@@ -54,6 +54,26 @@ class DocClaims(unittest.TestCase):
         self.assertTrue(any(os.path.isfile(os.path.join(folder, 'echo.py'))
                             for folder in (path, '/usr/lib/tf2_tools')), 'tf2_tools has no echo.py')
 
+    def test_the_repository_cites_only_itself(self):
+        """A user's clone holds the package alone: no file may cite design notes that are not in it
+        (the contract is docs/interface.md, the derivations docs/derivation.md)."""
+        root = rospkg.RosPack().get_path(PKG)
+        outside = re.compile(r'\.\./shared|\b(?:math|style)\.md\b|appendix\.txt')
+        for folder, folders, files in os.walk(root):
+            folders[:] = [f for f in folders if not f.startswith('.') and f != 'third_party']
+            for name in files:
+                path = os.path.join(folder, name)
+                try:
+                    with open(path, encoding='utf-8') as f:
+                        text = f.read()
+                except (UnicodeDecodeError, OSError):
+                    continue  # meshes, images
+                found = outside.search(text)
+                self.assertIsNone(found, '%s cites %r, which a clone does not have'
+                                  % (os.path.relpath(path, root), found and found.group(0)))
+                if 'interface.md' in text:
+                    self.assertTrue(os.path.isfile(os.path.join(root, 'docs', 'interface.md')), path)
+
 
 if __name__ == '__main__':
     rostest.rosrun(PKG, 'doc_claims', DocClaims)

@@ -1,5 +1,5 @@
 // The core library (include/diff_rigid_body/, src/core/) must never include a
-// ROS header, so that it builds and runs without roscpp (see style.md).
+// ROS header, so that it builds and runs without roscpp (see docs/architecture.md).
 #include <filesystem>
 #include <fstream>
 #include <regex>
