@@ -1,5 +1,5 @@
 // Rows of drb_bench_articulated for the dynamics of a robot (body_robots.h;
-// interface.md, Version 3), one state (x, x', x'' or tau) per iteration,
+// docs/interface.md, Version 3), one state (x, x', x'' or tau) per iteration,
 // gravity gamma = (0, 0, -9.81) m/s^2 for every method:
 //   inverse_dynamics/<robot>/<method>   tau = M x'' + c(x, x') + g(x)
 //       ours        inverseDynamics (RNEA) per body

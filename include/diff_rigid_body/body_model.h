@@ -1,4 +1,4 @@
-// The model of one body: what never changes after loading (interface.md,
+// The model of one body: what never changes after loading (docs/interface.md,
 // "Version 2"), built once from the URDF (urdf_scene.h). What every query
 // writes lives apart, in a BodyWorkspace (body_workspace.h); the algorithms
 // (kinematics.h, crba.h, mass_matrix_derivatives.h, vertex_jacobians.h,

@@ -1,6 +1,6 @@
 // Mass properties of a link or a composite of links, and the rules that
 // sort what a description gives into undefined (refused) and implausible
-// (loaded with a warning); interface.md, "Inertia from real URDFs".
+// (loaded with a warning); docs/interface.md, "Inertia from real URDFs".
 #pragma once
 
 #include <string>
@@ -23,7 +23,7 @@ struct MassProperties
 constexpr double kInertiaSymmetryTolerance = 1e-9;
 
 /// Checks mass properties read from a description and sorts what is wrong
-/// into two kinds (interface.md, "Inertia from real URDFs"):
+/// into two kinds (docs/interface.md, "Inertia from real URDFs"):
 ///   - undefined, thrown as InvalidInertiaError: a non-finite or negative mass,
 ///     a subnormal mass (m x would round away), a non-finite or asymmetric
 ///     tensor, a negative or subnormal principal moment;

@@ -2,7 +2,7 @@
 // (Featherstone 2008, ch. 5), in the fixed frame about the reference point r
 // (spatial.h, kinematics.h): the generalized forces
 //   tau = M(x) x'' + c(x, x') + g(x)
-// of interface.md, Version 3, for x' and x'' of d values each.
+// of docs/interface.md, Version 3, for x' and x'' of d values each.
 //
 // It runs in motion coordinates (body_model.h): nu = A x', nu' = A x'' + Q,
 // tau = A^T tau_nu (motion_coordinates.h). Forward, over the dofs k (parents

@@ -4,7 +4,7 @@
 // A body's coordinates x have d = dof values (get_bodies' dofs): a free
 // body's x is q = (phi, theta, psi [rad], tx, ty, tz [m]), d = 6; an
 // articulated body's x is its floating root's q (if it floats) followed by
-// its joint positions [rad or m] (interface.md, "Version 2"). Matrices are
+// its joint positions [rad or m] (docs/interface.md, "Version 2"). Matrices are
 // in x order.
 #pragma once
 

@@ -21,6 +21,8 @@
 #include <diff_rigid_body/Backprop.h>
 #include <diff_rigid_body/ForwardDynamics.h>
 #include <diff_rigid_body/GetBodies.h>
+#include <diff_rigid_body/GetCenterOfMass.h>
+#include <diff_rigid_body/GetFrameJacobians.h>
 #include <diff_rigid_body/GetMassMatrix.h>
 #include <diff_rigid_body/GetVertexJacobians.h>
 #include <diff_rigid_body/GetVertexJacobiansCompact.h>
@@ -59,6 +61,10 @@ DRB_POOL_SHARDING(InverseDynamics, "inverse_dynamics", (&Request::q, &Request::q
 DRB_POOL_SHARDING(ForwardDynamics, "forward_dynamics", (&Request::q, &Request::qdot, &Request::tau),
                   (&Response::qddot, &Response::dqddot_dq, &Response::dqddot_dqdot, &Response::dqddot_dtau,
                    &Response::cos_theta))
+DRB_POOL_SHARDING(GetFrameJacobians, "get_frame_jacobians", (&Request::q, &Request::qdot),
+                  (&Response::poses, &Response::jacobians, &Response::acceleration_bias, &Response::cos_theta))
+DRB_POOL_SHARDING(GetCenterOfMass, "get_center_of_mass", (&Request::q, &Request::qdot),
+                  (&Response::com, &Response::jacobians, &Response::acceleration_bias, &Response::cos_theta))
 #undef DRB_POOL_SHARDING
 
 /// The scene's d per body name, and its body order (an empty `bodies` field means all of them).

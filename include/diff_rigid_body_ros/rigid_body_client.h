@@ -41,6 +41,7 @@
 
 #include "diff_rigid_body_ros/client_arrays.h"
 #include "diff_rigid_body_ros/client_batches.h"
+#include "diff_rigid_body_ros/client_frames.h"
 #include "diff_rigid_body_ros/client_names.h"
 #include "diff_rigid_body_ros/client_requests.h"
 #include "diff_rigid_body_ros/client_responses.h"
@@ -156,6 +157,29 @@ public:
                                         bool derivatives = false)
   {
     return forwardDynamics(detail::values(x), detail::values(xdot), detail::values(tau), { body }, derivatives);
+  }
+
+  /// Poses and Jacobians (client_frames.h) of `body`'s link `frames` (empty = every link of the
+  /// body) at K configurations: `q` K d values (empty = the current state), `qdot` q's length or
+  /// empty (zeros, for the acceleration bias J'x'). The node's state is not changed.
+  FrameJacobians frameJacobians(const std::string& body, const std::vector<double>& q = {},
+                                const std::vector<std::string>& frames = {},
+                                FrameReference reference = FrameReference::LocalWorldAligned,
+                                const std::vector<double>& qdot = {}, bool acceleration_bias = false)
+  {
+    auto srv = detail::frameJacobiansRequest(body, frames, q, qdot, reference, acceleration_bias);
+    call("get_frame_jacobians", srv);
+    return toFrameJacobians(srv.response);
+  }
+
+  /// The centre of mass of `bodies` (empty = all), laid out as massMatrices; `jacobians` adds
+  /// dc/dx and the acceleration bias J'x' at `qdot` (q's length, or empty: zeros).
+  CenterOfMassResult centerOfMass(const std::vector<std::string>& bodies = {}, const std::vector<double>& q = {},
+                                  const std::vector<double>& qdot = {}, bool jacobians = false)
+  {
+    auto srv = detail::centerOfMassRequest(bodies, q, qdot, jacobians);
+    call("get_center_of_mass", srv);
+    return toCenterOfMass(srv.response);
   }
 
   /// Positions and J = dp/dx of `body`'s `vertices` (empty = all) at `q`

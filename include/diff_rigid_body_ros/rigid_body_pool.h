@@ -34,6 +34,7 @@
 #include <ros/ros.h>
 
 #include "diff_rigid_body_ros/client_batches.h"
+#include "diff_rigid_body_ros/client_frames.h"
 #include "diff_rigid_body_ros/client_requests.h"
 #include "diff_rigid_body_ros/client_responses.h"
 #include "diff_rigid_body_ros/pool_shards.h"
@@ -96,6 +97,23 @@ public:
     return toForwardDynamics(srv.response);
   }
   using EigenBatches<RigidBodyPool>::forwardDynamics;
+  /// As RigidBodyClient::frameJacobians and centerOfMass, sharded over the instances.
+  FrameJacobians frameJacobians(const std::string& body, const std::vector<double>& q,
+                                const std::vector<std::string>& frames = {},
+                                FrameReference reference = FrameReference::LocalWorldAligned,
+                                const std::vector<double>& qdot = {}, bool acceleration_bias = false)
+  {
+    auto srv = detail::frameJacobiansRequest(body, frames, q, qdot, reference, acceleration_bias);
+    call(srv);
+    return toFrameJacobians(srv.response);
+  }
+  CenterOfMassResult centerOfMass(const std::vector<std::string>& bodies, const std::vector<double>& q,
+                                  const std::vector<double>& qdot = {}, bool jacobians = false)
+  {
+    auto srv = detail::centerOfMassRequest(bodies, q, qdot, jacobians);
+    call(srv);
+    return toCenterOfMass(srv.response);
+  }
 
   /// As RigidBodyClient::vertexJacobians with K configurations: block k for qs[k] (Vector6d or VectorXd).
   std::vector<VertexJacobians> vertexJacobians(const std::string& body, const std::vector<Eigen::VectorXd>& qs,

@@ -21,6 +21,8 @@
 #include <diff_rigid_body/Echo.h>
 #include <diff_rigid_body/ForwardDynamics.h>
 #include <diff_rigid_body/GetBodies.h>
+#include <diff_rigid_body/GetCenterOfMass.h>
+#include <diff_rigid_body/GetFrameJacobians.h>
 #include <diff_rigid_body/GetMassMatrix.h>
 #include <diff_rigid_body/GetState.h>
 #include <diff_rigid_body/GetVertexJacobians.h>
@@ -41,6 +43,8 @@
   X(get_vertex_jacobians_compact,  GetVertexJacobiansCompact, getVertexJacobiansCompact, vertex_jacobians_compact, vertexJacobiansCompact, false) \
   X(inverse_dynamics,              InverseDynamics,           inverseDynamics,           inverse_dynamics,         inverseDynamics,        false) \
   X(forward_dynamics,              ForwardDynamics,           forwardDynamics,           forward_dynamics,         forwardDynamics,        false) \
+  X(get_frame_jacobians,           GetFrameJacobians,         getFrameJacobians,         frame_jacobians,          frameJacobians,         false) \
+  X(get_center_of_mass,            GetCenterOfMass,           getCenterOfMass,           center_of_mass,           centerOfMass,           false) \
   X(ping,                          Ping,                      ping,                      none,                     none,                   true)  \
   X(echo,                          Echo,                      echo,                      none,                     none,                   true)
 // clang-format on

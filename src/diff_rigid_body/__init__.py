@@ -16,7 +16,7 @@ beside these modules (catkin merges them).
 
 def __getattr__(name):
     if name in ('RigidBodyClient', 'DiffRigidBodyError', 'NodeNotFoundError', 'Bodies', 'MassMatrices',
-                'InverseDynamicsResult', 'ForwardDynamicsResult'):
+                'InverseDynamicsResult', 'ForwardDynamicsResult', 'FrameJacobians', 'CenterOfMass'):
         from diff_rigid_body import client
         return getattr(client, name)
     if name in ('RigidBodyPool', 'PoolError'):

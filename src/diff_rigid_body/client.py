@@ -13,7 +13,7 @@ with ``rospy.numpy_msg`` both ways, the same bytes, read-only arrays).
 Shapes (n bodies, N vertices, K configurations). A body's coordinates x
 have d = dof values (``bodies().dofs``): a free body's x is
 q = (phi, theta, psi, tx, ty, tz), d = 6; an articulated body's x is its
-floating root's q (if it floats), then its joint positions (interface.md,
+floating root's q (if it floats), then its joint positions (docs/interface.md,
 "Version 2"). Every ``q`` argument holds x:
 
 ==============================  ===============================================
@@ -37,6 +37,13 @@ floating root's q (if it floats), then its joint positions (interface.md,
                                 K configurations and bodies of different d as M
 ``forward_dynamics(...)``       x'' = M^-1 (tau - c - g): (n, d); dx''/dx,
                                 dx''/dx', dx''/dtau: (n, d, d); as inverse_dynamics
+``frame_jacobians(...)``        link frames: positions (F, 3), rotations (F, 3, 3),
+                                J (F, 6, d) (rows linear then angular, in the
+                                reference asked for), bias J'x' (F, 6); a
+                                leading K axis for a q of shape (K, d)
+                                (``client_frames``)
+``center_of_mass(...)``         com (n, 3) [m], J = dc/dx (n, 3, d), bias (n, 3);
+                                K configurations and bodies of different d as M
 ``get_state()``                 dict name -> x (d,)
 ==============================  ===============================================
 
@@ -66,16 +73,17 @@ from rospy.numpy_msg import numpy_msg
 
 from diff_rigid_body.client_arrays import (AnswerShape, floats, indices, optional_values, vertex_blocks,
                                           vertex_configurations, wire_message)
+from diff_rigid_body.client_frames import CenterOfMass, FrameJacobians, FrameQueries
 from diff_rigid_body.client_names import NodeNotFoundError, body_names, missing_node_message
 from diff_rigid_body.client_types import (Bodies, DiffRigidBodyError, ForwardDynamicsResult,
                                          InverseDynamicsResult, Joint, Link, MassMatrices, bodies_from_response)
 from diff_rigid_body.msg import BodyState
-from diff_rigid_body.srv import (Backprop, ForwardDynamics, GetBodies, GetMassMatrix, GetState, GetVertexJacobians,
-                                 GetVertexJacobiansCompact, InverseDynamics, SetState)
+from diff_rigid_body.srv import (Backprop, ForwardDynamics, GetBodies, GetCenterOfMass, GetFrameJacobians, GetMassMatrix,
+                                 GetState, GetVertexJacobians, GetVertexJacobiansCompact, InverseDynamics, SetState)
 from diff_rigid_body.tcpros import ServiceConnection
 
 __all__ = ['DiffRigidBodyError', 'RigidBodyClient', 'Bodies', 'Joint', 'Link', 'MassMatrices', 'InverseDynamicsResult',
-           'ForwardDynamicsResult', 'CONNECTION_ERRORS', 'NodeNotFoundError']
+           'ForwardDynamicsResult', 'FrameJacobians', 'CenterOfMass', 'CONNECTION_ERRORS', 'NodeNotFoundError']
 
 #: What a call raises when the node cannot be reached or the connection drops (not a refusal).
 CONNECTION_ERRORS = (rospy.ServiceException, rospy.ROSException, rospy.exceptions.TransportException, OSError)
@@ -92,7 +100,7 @@ def _numpy_service(service_class):
     })
 
 
-class RigidBodyClient(object):
+class RigidBodyClient(FrameQueries):
     """Persistent-connection client of one rigid_body_server.
 
     :param server: the node's name, resolved like any ROS name (a relative name
@@ -121,6 +129,8 @@ class RigidBodyClient(object):
         'get_vertex_jacobians_compact': GetVertexJacobiansCompact,
         'inverse_dynamics': InverseDynamics,
         'forward_dynamics': ForwardDynamics,
+        'get_frame_jacobians': GetFrameJacobians,
+        'get_center_of_mass': GetCenterOfMass,
     }
 
     def __init__(self, server='rigid_body_server', timeout=30.0, reconnect=True, transport='tcpros'):

@@ -1,4 +1,4 @@
-"""Joint-space fitting of an articulated body (interface.md "Version 2"):
+"""Joint-space fitting of an articulated body (docs/interface.md "Version 2"):
 recover its coordinates x from observed vertex positions, as inverse
 kinematics or camera-to-robot calibration do.
 

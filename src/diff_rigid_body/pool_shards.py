@@ -25,6 +25,8 @@ SHARDED = {
                                                           'cos_theta')),
     'forward_dynamics': Sharding(('q', 'qdot', 'tau'), ('qddot', 'dqddot_dq', 'dqddot_dqdot', 'dqddot_dtau',
                                                         'cos_theta')),
+    'get_frame_jacobians': Sharding(('q', 'qdot'), ('poses', 'jacobians', 'acceleration_bias', 'cos_theta')),
+    'get_center_of_mass': Sharding(('q', 'qdot'), ('com', 'jacobians', 'acceleration_bias', 'cos_theta')),
 }
 
 

@@ -356,6 +356,36 @@ bool RigidBodyServer::forwardDynamics(ForwardDynamics::Request& request, Forward
   });
 }
 
+bool RigidBodyServer::getFrameJacobians(GetFrameJacobians::Request& request, GetFrameJacobians::Response& response)
+{
+  return serve(response, "get_frame_jacobians", [&] {
+    FrameJacobianAnswer answer;
+    queries_.frameJacobians(*snapshot(), request.body, request.frames, request.q, request.qdot, request.reference,
+                            request.acceleration_bias, answer);
+    response.frames = std::move(answer.frames);
+    response.dofs = answer.dofs;
+    response.poses = std::move(answer.poses);
+    response.jacobians = std::move(answer.jacobians);
+    response.acceleration_bias = std::move(answer.acceleration_bias);
+    response.cos_theta = std::move(answer.cos_theta);
+  });
+}
+
+bool RigidBodyServer::getCenterOfMass(GetCenterOfMass::Request& request, GetCenterOfMass::Response& response)
+{
+  return serve(response, "get_center_of_mass", [&] {
+    CenterOfMassAnswer answer;
+    queries_.centerOfMass(*snapshot(), request.bodies, request.q, request.qdot, request.jacobians, answer);
+    response.bodies = std::move(answer.bodies);
+    response.dofs = std::move(answer.dofs);
+    response.masses = std::move(answer.masses);
+    response.com = std::move(answer.com);
+    response.jacobians = std::move(answer.jacobians);
+    response.acceleration_bias = std::move(answer.acceleration_bias);
+    response.cos_theta = std::move(answer.cos_theta);
+  });
+}
+
 bool RigidBodyServer::ping(Ping::Request&, Ping::Response& response)
 {
   return serve(response, "ping", [] {});

@@ -108,6 +108,8 @@ private:
                                  GetVertexJacobiansCompact::Response& response);
   bool inverseDynamics(InverseDynamics::Request& request, InverseDynamics::Response& response);
   bool forwardDynamics(ForwardDynamics::Request& request, ForwardDynamics::Response& response);
+  bool getFrameJacobians(GetFrameJacobians::Request& request, GetFrameJacobians::Response& response);
+  bool getCenterOfMass(GetCenterOfMass::Request& request, GetCenterOfMass::Response& response);
   bool ping(Ping::Request& request, Ping::Response& response);
   bool echo(Echo::Request& request, Echo::Response& response);
   void onSetStates(const BodyStateArray::ConstPtr& message);

@@ -147,7 +147,7 @@ int main(int argc, char** argv)
         scene = loadScene(nh, private_nh);
       }))
     return 1;
-  // With ~joints: model only planar joints are left unmodelled, which interface.md asks to warn about;
+  // With ~joints: model only planar joints are left unmodelled, which docs/interface.md asks to warn about;
   // with ~joints: free every 1-dof joint is, by request.
   const bool free_joints = private_nh.param<std::string>("joints", "model") == "free";
   for (const std::string& joint : scene.unmodelled_joints)

@@ -77,6 +77,57 @@ TEST(CppClient, BatchedMassMatricesMatchSingleCallsAndLayout)
     }
 }
 
+TEST(CppClient, FrameJacobiansOfAFreeBodyAndItsMergedLink)
+{
+  // The rock at K = 2 configurations: its link and its merged handle move rigidly with it, so
+  // d(origin)/dt = I3, the angular rows do not depend on t, and v = w x (p - t) for the rotation
+  // columns; the rock's link origin is t - R c (c = get_bodies' com_offset: t is the COM).
+  RigidBodyClient client;
+  const auto bodies = client.bodies();
+  std::vector<double> q{ 0.3, -0.4, 1.1, 0.05, -0.1, 0.6, -0.7, 0.2, 0.4, 1.0, 2.0, -3.0 };
+  const auto answer = client.frameJacobians("rock", q, {}, diff_rigid_body_ros::FrameReference::LocalWorldAligned);
+  ASSERT_EQ(answer.frames, (std::vector<std::string>{ "rock", "rock_handle" }));
+  ASSERT_EQ(answer.configurations, 2u);
+  ASSERT_EQ(answer.J.size(), 4u);
+  EXPECT_TRUE(answer.bias.empty());
+  for (std::size_t k = 0; k < 2; ++k)
+  {
+    const Eigen::Vector3d t = Eigen::Map<const Eigen::Vector3d>(q.data() + 6 * k + 3);
+    const Eigen::Matrix3d R = answer.poses[answer.index(k, 0)].linear();
+    EXPECT_LT((answer.poses[answer.index(k, 0)].translation() - (t - R * bodies.com_offsets[1])).norm(), 1e-14);
+    for (std::size_t f = 0; f < 2; ++f)
+    {
+      const auto& J = answer.J[answer.index(k, f)];
+      const Eigen::Vector3d r = answer.poses[answer.index(k, f)].translation() - t;
+      Eigen::Matrix3d r_cross;
+      r_cross << 0, -r.z(), r.y(), r.z(), 0, -r.x(), -r.y(), r.x(), 0;
+      EXPECT_LT((J.block<3, 3>(0, 3) - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(), 1e-15);
+      EXPECT_EQ(J.block<3, 3>(3, 3).cwiseAbs().maxCoeff(), 0.0);
+      EXPECT_LT((J.block<3, 3>(0, 0) + r_cross * J.block<3, 3>(3, 0)).cwiseAbs().maxCoeff(), 1e-14);
+    }
+  }
+}
+
+TEST(CppClient, CenterOfMassOfFreeBodiesIsTheirTranslation)
+{
+  RigidBodyClient client;
+  const std::vector<double> q{ 0.3, -0.4, 1.1, 0.05, -0.1, 0.6, -0.7, 0.2, 0.4, 1.0, 2.0, -3.0 };
+  const auto answer = client.centerOfMass({ "knot", "rock" }, q, {}, /*jacobians=*/true);
+  ASSERT_EQ(answer.configurations, 1u);
+  ASSERT_EQ(answer.J.size(), 2u);
+  const auto bodies = client.bodies();
+  for (std::size_t i = 0; i < 2; ++i)
+  {
+    EXPECT_EQ(answer.masses[i], bodies.masses[i]);
+    EXPECT_EQ(answer.com[i], Eigen::Map<const Eigen::Vector3d>(q.data() + 6 * i + 3));
+    EXPECT_EQ(answer.J[i].leftCols(3).cwiseAbs().maxCoeff(), 0.0);
+    EXPECT_EQ(answer.J[i].rightCols(3), Eigen::Matrix3d::Identity());
+    EXPECT_EQ(answer.bias[i], Eigen::Vector3d::Zero());
+  }
+  DRB_EXPECT_THROWS_MESSAGE(client.centerOfMass({ "nothing" }), diff_rigid_body_ros::ServiceError,
+                            "unknown body 'nothing'");
+}
+
 TEST(CppClient, BatchedCallsTakeOneEigenVectorPerConfiguration)
 {
   // massMatrices, inverseDynamics and forwardDynamics take std::vector<Vector6d> (or VectorXd), as

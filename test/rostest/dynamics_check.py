@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""~inverse_dynamics and ~forward_dynamics (interface.md "Version 3") through the Python client,
+"""~inverse_dynamics and ~forward_dynamics (docs/interface.md "Version 3") through the Python client,
 on the Franka Panda (one fixed-base body, d = 8, ~joints: model) and on the default scene (two
 free bodies, d = 6), each checked against identities and oracles that do not use the node's
 dynamics code (dynamics.test):

@@ -1,5 +1,5 @@
 """Oracles for the dynamics rostests (dynamics_check.py), written from the
-definitions of interface.md "Version 3" without the node's dynamics code:
+definitions of docs/interface.md "Version 3" without the node's dynamics code:
 
 - the Christoffel Coriolis matrix from dM/dx (get_mass_matrix's derivatives);
 - the potential V(x) = - sum over links of m_l gamma^T c_l(x), its COMs c_l from

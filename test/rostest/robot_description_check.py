@@ -13,7 +13,7 @@ Private parameters (set them in the .test file):
   ~geometry   collision | visual: the kind the node was told to use (default collision)
   ~server     node name (default /rigid_body_server)
 
-With ~joints: model (the default, interface.md "Version 2") an arm is one
+With ~joints: model (the default, docs/interface.md "Version 2") an arm is one
 body holding all its links; with ~joints: free every jointed link is its own
 body. The checks hold in both modes:
 

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Articulated bodies at node level: the Panda (fixed base, one body, 9 moving links) driven through
-joint_states, and the UR5's mass matrix (interface.md, "Version 2").
+joint_states, and the UR5's mass matrix (docs/interface.md, "Version 2").
 
 Independent oracle: forward kinematics written here from the URDF XML (xml.etree, numpy): a
 link's pose is parent pose * joint origin (xyz, rpy: R = Rz(y) Ry(p) Rx(r)) * joint motion

@@ -14,6 +14,10 @@ everything that must agree with it (service_registry.test):
   service that is not in the registry), a row for each Python method in the
   Python client's method table and one for each C++ method in the C++ one.
 A service without a client method (`none`) must be benchmark-only.
+Every service that takes K configurations (a request field `float64[] q`) is in both pools'
+sharding tables (pool_shards.py, pool_shards.h), sharding every float array of its request and
+every per-configuration float array of its answer: a service left out would silently stop being
+split across instances.
 GetBodies.srv and BodyState.msg comment every field in the user's terms, `rossrv show -r` prints the
 comments, and README.md names that command.
 """
@@ -29,6 +33,7 @@ import rospkg
 import rostest
 
 from diff_rigid_body.client import RigidBodyClient
+from diff_rigid_body.pool_shards import SHARDED
 
 PKG = 'diff_rigid_body'
 SERVER = '/rigid_body_server'              # ~benchmark_services unset
@@ -38,6 +43,8 @@ ROSCPP_SERVICES = {'get_loggers', 'set_logger_level'}  # roscpp's own, on every 
 
 ENTRY = re.compile(r'^\s*X\(\s*(\w+)\s*,\s*(\w+)\s*,\s*(\w+)\s*,\s*(\w+)\s*,\s*(\w+)\s*,\s*(true|false)\s*\)', re.M)
 FIELDS = ('name', 'srv_type', 'handler', 'python_method', 'cpp_method', 'benchmark_only')
+CPP_SHARDING = re.compile(r'DRB_POOL_SHARDING\(\s*\w+\s*,\s*"(\w+)"\s*,\s*\(([^)]*)\)\s*,\s*\(([^)]*)\)\)')
+PER_BODY_FIELDS = {'masses'}  # answer arrays of one value per body, the same in every shard
 
 
 def package_file(*parts):
@@ -156,7 +163,8 @@ class ServiceRegistry(unittest.TestCase):
 
     def test_cpp_client_wraps_every_service(self):
         header = read('include', 'diff_rigid_body_ros', 'rigid_body_client.h')
-        requests = header + read('include', 'diff_rigid_body_ros', 'client_requests.h')  # built there or here
+        requests = header + ''.join(read('include', 'diff_rigid_body_ros', name)  # built there or here
+                                    for name in ('client_requests.h', 'client_frames.h'))
         for e in self.entries:
             if e['cpp_method'] == 'none':
                 continue
@@ -167,7 +175,26 @@ class ServiceRegistry(unittest.TestCase):
                             % (e['cpp_method'], e['name']))
             self.assertIn('"%s"' % e['name'], header, 'rigid_body_client.h never calls %s' % e['name'])
             self.assertIn('diff_rigid_body::%s srv' % e['srv_type'], requests,
-                          'rigid_body_client.h (with client_requests.h) never builds a diff_rigid_body::%s for %s' % (e['srv_type'], e['name']))
+                          'rigid_body_client.h (with client_requests.h, client_frames.h) never builds a diff_rigid_body::%s for %s' % (e['srv_type'], e['name']))
+
+    def test_pools_shard_every_batched_service(self):
+        cpp = {name: (set(re.findall(r'&Request::(\w+)', request)), set(re.findall(r'&Response::(\w+)', response)))
+               for name, request, response in CPP_SHARDING.findall(read('include', 'diff_rigid_body_ros',
+                                                                        'pool_shards.h'))}
+        python = {name: (set(s.request), set(s.response)) for name, s in SHARDED.items()}
+        batched = set()
+        for e in self.entries:
+            request, _, response = read('srv', e['srv_type'] + '.srv').partition('\n---')
+            arrays = [set(re.findall(r'^float(?:64|32)\[\]\s+(\w+)', part, re.M)) for part in (request, response)]
+            if 'q' not in arrays[0]:
+                continue
+            batched.add(e['name'])
+            wanted = (arrays[0], arrays[1] - PER_BODY_FIELDS)
+            for table, entries in (('pool_shards.py SHARDED', python), ('pool_shards.h', cpp)):
+                self.assertIn(e['name'], entries, '%s: no sharding for %s' % (table, e['name']))
+                self.assertEqual(entries[e['name']], wanted, '%s: the sharded fields of %s' % (table, e['name']))
+        for table, entries in (('pool_shards.py SHARDED', python), ('pool_shards.h', cpp)):
+            self.assertEqual(set(entries) - batched, set(), '%s shards services without a q' % table)
 
     def test_readme_services_table(self):
         rows = table_keys(markdown_section(read('README.md'), '### Services'), r'`~(\w+)`')

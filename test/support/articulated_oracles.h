@@ -1,4 +1,4 @@
-// Independent oracles for articulated bodies (interface.md, "Version 2").
+// Independent oracles for articulated bodies (docs/interface.md, "Version 2").
 // Nothing here uses the core (kinematics.h, crba.h): the coordinates, joint limits
 // and mimic map are read from the URDF (tinyxml2 for document order,
 // urdfdom for the model), link poses are products of Eigen isometries and

@@ -1,4 +1,4 @@
-// Articulated bodies (interface.md, "Version 2") in the hard cases:
+// Articulated bodies (docs/interface.md, "Version 2") in the hard cases:
 //   - 256-bit MPFR: crba<mpfr::mpreal> at the same x is the
 //     reference for the double M: the floating tree at pitch pi/2 and
 //     pi/2 +- 1e-k (k = 3, 6, 9), every fixture with its joints at their

@@ -1,4 +1,4 @@
-// Articulated bodies (interface.md, "Version 2") against MuJoCo loading the
+// Articulated bodies (docs/interface.md, "Version 2") against MuJoCo loading the
 // same URDF text (test/support/mujoco_model.h): the floating-base tree of
 // articulated_fixtures.h, which KDL cannot check (no floating joint), and
 // the UR5 (fixed base). MuJoCo refuses a massless body that has a joint, so

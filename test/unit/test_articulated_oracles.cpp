@@ -1,4 +1,4 @@
-// Articulated bodies (interface.md, "Version 2") against independent oracles,
+// Articulated bodies (docs/interface.md, "Version 2") against independent oracles,
 // on the fixture robots (UR5, the three double pendulums, the Panda with its
 // mimic fingers) and a floating-base tree (two legs, a mimic knee, a
 // prismatic slider, a massless wrist):

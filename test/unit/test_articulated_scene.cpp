@@ -1,4 +1,4 @@
-// Loading kinematic trees (~joints: model, interface.md "Version 2"): which
+// Loading kinematic trees (~joints: model, docs/interface.md "Version 2"): which
 // links form a body, its coordinates and limits, mimic joints, vertex ranges,
 // warnings; and the textbook two-link arm's M(x) as a closed-form oracle.
 #include <cmath>

@@ -1,4 +1,5 @@
-// The bad-input rows of ~inverse_dynamics and ~forward_dynamics (D): each
+// The bad-input rows of ~inverse_dynamics, ~forward_dynamics,
+// ~get_frame_jacobians and ~get_center_of_mass (D): each
 // refused before anything is computed (lengths, NaN, unknown bodies, answers
 // over the budget) or after (a singular M for forward dynamics), on the
 // two free bodies cube and ball of urdf::twoBodies() and the plumbing
@@ -45,6 +46,15 @@ std::string forward(const std::vector<std::string>& bodies, const std::vector<do
   drb::ForwardDynamicsAnswer answer;
   freeBodies().forwardDynamics(freeBodies().initialState(), bodies, q, qdot, tau, derivatives, answer);
   return "accepted: " + std::to_string(answer.cos_theta.size()) + " configurations x bodies";
+}
+
+std::string frames(const std::string& body, const std::vector<std::string>& names, const std::vector<double>& q,
+                   const std::vector<double>& qdot, std::uint32_t reference)
+{
+  drb::FrameJacobianAnswer answer;
+  freeBodies().frameJacobians(freeBodies().initialState(), body, names, q, qdot, reference, true, answer);
+  return "accepted: " + std::to_string(answer.frames.size()) + " frames x " + std::to_string(answer.cos_theta.size()) +
+         " configurations";
 }
 
 /// q of one configuration of cube at pitch `theta` [rad].
@@ -103,6 +113,32 @@ std::vector<Row> dynamicsRows()
       [] {
         EXPECT_EQ(forward({}, std::vector<double>(36, 0.25), {}, {}, true), "accepted: 6 configurations x bodies");
         return std::string("accepted: x'', dx''/dx, dx''/dx' and M^-1 per configuration and body");
+      } },
+    { "D13", "get_frame_jacobians: a frame that is not a link of the body", Expect::Refused, "InvalidArgumentError",
+      "frames[1]: unknown frame 'ghost'", [] { return frames("cube", { "cube", "ghost" }, {}, {}, 0); } },
+    { "D14", "get_frame_jacobians: reference 3", Expect::Refused, "InvalidArgumentError", "reference: 3 is not one of",
+      [] { return frames("cube", {}, {}, {}, 3); } },
+    { "D15", "get_frame_jacobians: qdot of 5 values for one configuration", Expect::Refused,
+      "InvalidArgumentError", "qdot: expected 6 values",
+      [] { return frames("cube", {}, std::vector<double>(6, 0.0), std::vector<double>(5, 0.0), 2); } },
+    { "D16", "get_frame_jacobians: q NaN", Expect::Refused, "InvalidArgumentError", "q[2]: not finite",
+      [] { return frames("cube", {}, { 0, 0, kNaN, 0, 0, 0 }, {}, 1); } },
+    { "D17", "get_frame_jacobians: a free body at gimbal lock, 2 configurations", Expect::Accepted, "", "",
+      [=] {
+        std::vector<double> q = cubeAt(0.2), locked = cubeAt(half_pi);
+        q.insert(q.end(), locked.begin(), locked.end());
+        EXPECT_EQ(frames("cube", {}, q, std::vector<double>(12, 1.0), 0), "accepted: 1 frames x 2 configurations");
+        return std::string("accepted: poses, J and J'x' finite (J is defined on the chart's singular set too)");
+      } },
+    { "D18", "get_center_of_mass: a body without mass", Expect::Refused, "InvalidArgumentError", "has no mass",
+      [] {
+        drb::BodyModel crane = plumbing::crane();
+        for (drb::Segment& segment : crane.segments)
+          segment.inertia = drb::MassProperties();
+        static const drb::SceneQueries queries(plumbing::scene(plumbing::arm(), crane));
+        drb::CenterOfMassAnswer answer;
+        queries.centerOfMass(queries.initialState(), { "crane" }, {}, {}, true, answer);
+        return std::string("accepted");
       } },
   };
 }

@@ -1,4 +1,4 @@
-// What real robot descriptions contain and the contract loads (interface.md,
+// What real robot descriptions contain and the contract loads (docs/interface.md,
 // "Version 2"): massless frames and links without <inertial> merge as
 // massless; implausible inertia warns, naming the link, and is refused only
 // with strict_inertia; undefined inertia is always refused; a body that
