@@ -102,7 +102,7 @@ TEST(CppClient, FrameJacobiansOfAFreeBodyAndItsMergedLink)
       Eigen::Matrix3d r_cross;
       r_cross << 0, -r.z(), r.y(), r.z(), 0, -r.x(), -r.y(), r.x(), 0;
       EXPECT_LT((J.block<3, 3>(0, 3) - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(), 1e-15);
-      EXPECT_EQ(J.block<3, 3>(3, 3).cwiseAbs().maxCoeff(), 0.0);
+      EXPECT_EQ((J.block<3, 3>(3, 3).cwiseAbs().maxCoeff()), 0.0);
       EXPECT_LT((J.block<3, 3>(0, 0) + r_cross * J.block<3, 3>(3, 0)).cwiseAbs().maxCoeff(), 1e-14);
     }
   }
@@ -119,7 +119,7 @@ TEST(CppClient, CenterOfMassOfFreeBodiesIsTheirTranslation)
   for (std::size_t i = 0; i < 2; ++i)
   {
     EXPECT_EQ(answer.masses[i], bodies.masses[i]);
-    EXPECT_EQ(answer.com[i], Eigen::Map<const Eigen::Vector3d>(q.data() + 6 * i + 3));
+    EXPECT_EQ(answer.com[i], (Eigen::Map<const Eigen::Vector3d>(q.data() + 6 * i + 3)));
     EXPECT_EQ(answer.J[i].leftCols(3).cwiseAbs().maxCoeff(), 0.0);
     EXPECT_EQ(answer.J[i].rightCols(3), Eigen::Matrix3d::Identity());
     EXPECT_EQ(answer.bias[i], Eigen::Vector3d::Zero());
