@@ -21,12 +21,13 @@ using detail::slice;
 namespace
 {
 /// A listed frame: a link of the body (model.links index), or a static link
-/// (scene.static_links index, `fixed`).
+/// (scene.static_links index, `fixed`; kFixedFrame for the fixed frame itself).
 struct FrameSlot
 {
   std::size_t index = 0;
   bool fixed = false;
 };
+constexpr std::size_t kFixedFrame = static_cast<std::size_t>(-1);
 
 /// "a, b, c" of at most 20 names, then how many there are.
 template <typename Names>
@@ -72,10 +73,16 @@ void frameSlots(const Scene& scene, const BodyModel& body, const std::vector<std
       slots.push_back({ static_cast<std::size_t>(fixed - scene.static_links.begin()), true });
       continue;
     }
+    if (frames[f] == scene.fixed_frame)
+    {
+      slots.push_back({ kFixedFrame, true });
+      continue;
+    }
     const std::string name = frames[f].size() > 64 ? frames[f].substr(0, 64) + "..." : frames[f];
     reject("frames[" + std::to_string(f) + "]: unknown frame '" + name + "': not a link of body '" + body.name +
-           "' (its links: " + listed(body.links) + ") nor a static link" +
-           (scene.static_links.empty() ? "" : " (" + listed(scene.static_links) + ")"));
+           "' (its links: " + listed(body.links) + "), a static link" +
+           (scene.static_links.empty() ? "" : " (" + listed(scene.static_links) + ")") + " or the fixed frame '" +
+           scene.fixed_frame + "'");
   }
 }
 
@@ -87,11 +94,11 @@ FrameReference frameReference(std::uint32_t reference)
   return static_cast<FrameReference>(reference);
 }
 
-/// A static link's slot: its fixed pose, zero Jacobian and bias.
-void writeStaticFrame(const StaticLink& link, std::size_t d, double* pose12, double* jacobian, double* bias)
+/// A static frame's slot: its fixed pose, zero Jacobian and bias.
+void writeStaticFrame(const Eigen::Isometry3d& pose, std::size_t d, double* pose12, double* jacobian, double* bias)
 {
-  const Eigen::Vector3d p = link.pose_in_fixed_frame.translation();
-  const Eigen::Matrix3d R = link.pose_in_fixed_frame.linear();
+  const Eigen::Vector3d p = pose.translation();
+  const Eigen::Matrix3d R = pose.linear();
   for (int i = 0; i < 3; ++i)
     pose12[i] = p[i];
   for (int r = 0; r < 3; ++r)
@@ -121,7 +128,9 @@ void SceneQueries::frameJacobians(const SceneState& current, const std::string& 
   checkDynamicsBudget(K, F * (12 + 6 * d + (acceleration_bias ? 6 : 0)) + 1, true);
   answer.frames.resize(F);
   for (std::size_t f = 0; f < F; ++f)
-    answer.frames[f] = slots[f].fixed ? scene_.static_links[slots[f].index].name : body.links[slots[f].index].name;
+    answer.frames[f] = !slots[f].fixed                 ? body.links[slots[f].index].name
+                       : slots[f].index == kFixedFrame ? scene_.fixed_frame
+                                                       : scene_.static_links[slots[f].index].name;
   answer.dofs = static_cast<std::uint32_t>(d);
   answer.poses.resize(K * F * 12);
   answer.jacobians.resize(K * F * 6 * d);
@@ -139,8 +148,9 @@ void SceneQueries::frameJacobians(const SceneState& current, const std::string& 
       const std::size_t n = k * F + f;
       double* bias = acceleration_bias ? answer.acceleration_bias.data() + 6 * n : nullptr;
       if (slots[f].fixed)
-        writeStaticFrame(scene_.static_links[slots[f].index], d, answer.poses.data() + 12 * n,
-                         answer.jacobians.data() + 6 * d * n, bias);
+        writeStaticFrame(slots[f].index == kFixedFrame ? Eigen::Isometry3d::Identity()
+                                                       : scene_.static_links[slots[f].index].pose_in_fixed_frame,
+                         d, answer.poses.data() + 12 * n, answer.jacobians.data() + 6 * d * n, bias);
       else
         frameJacobian(body, ws, slots[f].index, ref, answer.poses.data() + 12 * n,
                       answer.jacobians.data() + 6 * d * n, bias);

@@ -11,7 +11,8 @@ v - w x p); (c) J'x' equals the second difference of the position along x' (line
 difference of J along x' times x' (angular rows); (d) the COM is the mass-weighted link COM of the
 oracle, its Jacobian the COM's central differences, its bias the second difference; a free body's
 COM is its (tx, ty, tz) and its Jacobian [0 | I3]; (e) a pool of two instances answers K
-configurations with the bits of one instance; (f) refusals name what is wrong and change nothing.
+configurations with the bits of one instance; (f) a static link (the fixed frame here) is a frame with zero columns, and
+refusals name what is wrong and change nothing.
 """
 import sys
 import unittest
@@ -131,6 +132,18 @@ class Frames(unittest.TestCase):
         one = self.client.center_of_mass(q=xs, qdot=xds, jacobians=True)
         for field in ('masses', 'com', 'J', 'bias', 'cos_theta'):
             self.assertTrue(np.array_equal(getattr(ours, field), getattr(one, field)), field)
+
+    def test_f_a_static_link_is_a_frame_with_zero_columns(self):
+        static = [name for name in self.urdf_links() if name not in {link.name for link in self.links}]
+        self.assertEqual(static, ['panda_link0'])  # the root link: the fixed frame
+        answer = self.client.frame_jacobians(self.body, q=self.random_x(), frames=static, acceleration_bias=True)
+        pose = self.oracle(np.zeros(self.d))['panda_link0']
+        self.assertTrue(np.array_equal(answer.positions[0], pose[:3, 3]))
+        self.assertTrue(np.array_equal(answer.rotations[0], pose[:3, :3]))
+        self.assertFalse(answer.J.any() or answer.bias.any())
+
+    def urdf_links(self):
+        return {j['parent'] for j in self.urdf_joints.values()} | {j['child'] for j in self.urdf_joints.values()}
 
     def test_f_refusals_name_what_is_wrong(self):
         x = self.random_x()
