@@ -88,6 +88,7 @@ int main(int argc, char** argv)
     registerBodyRows(robot);
     registerVertexRows(robot);
     registerDynamicsRows(robot);
+    registerFrameRows(robot);
   }
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();

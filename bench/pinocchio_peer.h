@@ -202,6 +202,13 @@ public:
   /// (q, v, a = 0) (centerOfMass's subtree values). Throws
   /// std::invalid_argument for an unknown joint.
   CenterOfMass centerOfMass(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const std::string& joint);
+  /// The frame index of URDF link `link` (throws std::invalid_argument for an unknown link).
+  std::size_t frameOf(const std::string& link) const;
+  /// computeFrameJacobian of frame `frame` (frameOf) in `reference` alone: what a per-frame
+  /// Jacobian costs in Pinocchio (the supporting joints' placements included).
+  const Matrix6Xd& computeFrameJacobian(const Eigen::VectorXd& q, std::size_t frame, int reference);
+  /// jacobianCenterOfMass of the whole model (its COM and 3 x nv Jacobian).
+  const Eigen::Matrix3Xd& jacobianCenterOfMass(const Eigen::VectorXd& q);
 
   /// Inverse dynamics tau = M(q) a + C(q, v) v + g(q) [N, N m].
   const Eigen::VectorXd& rnea(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& a);

@@ -152,6 +152,28 @@ def vertex_table(r):
         row(f"read floor, `{rname}`: gradients and vertex columns read once (48 B per vertex)", FLOOR, rfloor, rfloor)])
 
 
+NODE_FRAME = "yes: `SceneQueries::frameJacobians` → `forwardKinematicsOf` (the frame's path) + `frameJacobian`"
+NODE_COM = "yes: `SceneQueries::centerOfMass` with Jacobians → `centerOfMass`"
+
+
+def frames_table(r):
+    def row(label, node, quantity, method):
+        time, ours = r.t(quantity, method), r.t(quantity, "ours")
+        return [label, node, fmt_time(time), ratio(time, ours) if method != "ours" else "1"]
+
+    rows = [row("ours: pose + 6 × d Jacobian, `frameJacobian`", NODE_FRAME, "frame_jacobian", "ours"),
+            row("ours: `SceneQueries::frameJacobians`, that frame, one configuration (whole call)",
+                "yes: the node's whole call", "frame_jacobian", "node_call"),
+            row("Pinocchio `computeFrameJacobian` (LOCAL_WORLD_ALIGNED)", PEER, "frame_jacobian", "pinocchio"),
+            row("KDL `ChainJntToJacSolver::JntToJac` (its chain)", PEER, "frame_jacobian", "kdl"),
+            row("MuJoCo `mj_kinematics` + `mj_comPos` + `mj_jacBody`", PEER, "frame_jacobian", "mujoco")]
+    if r.t("com_jacobian", "ours"):
+        rows += [row("ours: centre of mass + 3 × d Jacobian, `centerOfMass`", NODE_COM, "com_jacobian", "ours"),
+                 row("Pinocchio `jacobianCenterOfMass` (whole model)", PEER, "com_jacobian", "pinocchio"),
+                 row("MuJoCo `mj_kinematics` + `mj_comPos` + `mj_jacSubtreeCom`", PEER, "com_jacobian", "mujoco")]
+    return md_table(["method", "node runs", "time", "÷ ours"], rows)
+
+
 def section_articulated(data, targets):
     k = kernel_table(data)
     rows = {robot: Rows(k, data, robot) for robot in ROBOTS if context_of(data, robot)}
@@ -193,6 +215,13 @@ def section_articulated(data, targets):
                  f"M's condition number λmax/λmin reaches {float(r.c.get('conditioning.M', 'nan')):.3g} over the "
                  "error states: ẍ and M⁻¹ may carry that many ε of relative error, whatever the method.", "",
                  dynamics_table(r)]
+        if r.t("frame_jacobian", "ours"):
+            text += ["", f"### {r.c['label']}: a link frame's Jacobian (`{r.c.get('kdl.chain', '?').split('..')[-1]}`, "
+                     "KDL's chain tip) and the centre of mass", "",
+                     "One configuration per iteration, the poses of the supporting links included; LOCAL_WORLD_ALIGNED "
+                     "(the tip's origin, fixed-frame axes) for every method. Agreement is tested, not timed "
+                     "(test_dynamics_pinocchio.cpp, test_frames_kdl_mujoco.cpp: within 1e-11 relative).", "",
+                     frames_table(r)]
         if r.find("jacobian", "ours")[0]:
             text += ["", f"### {r.c['label']}: vertex Jacobians and backprop over every collision-mesh vertex "
                      f"({int(r.c['vertices']):,})", "",

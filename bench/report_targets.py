@@ -1,5 +1,5 @@
 """The targets of issues 18 (one body model: M, dM/dx, vertices), 20
-(dynamics) and 28 (motion coordinates inside) for the targets table of docs/benchmarks.md, from the rows of
+(dynamics), 28 (motion coordinates inside) and 29 (frame Jacobians) for the targets table of docs/benchmarks.md, from the rows of
 report_articulated.py: one line per target, each robot's measured ratio,
 met only when every robot it names meets it."""
 from report_format import EPS, verdict
@@ -114,7 +114,7 @@ def articulated_targets(rows):
                ALL, lambda r: worst_error(r, ["dtau_dx.ours", "dtau_dxd.ours", "dfd_dx.ours", "dfd_dxd.ours",
                                               "minv.ours"]), lambda v: v <= FEW_ULP, " ε"),
     ]
-    return lines + issue28_targets(rows)
+    return lines + issue28_targets(rows) + issue29_targets(rows)
 
 
 def issue28_targets(rows):
@@ -144,4 +144,19 @@ def issue28_targets(rows):
                floor("backprop", "floor_read"), lambda v: v <= 1.5),
         target(rows, "Issue 28: floating humanoid backprop ≤ 3× its read floor", ("humanoid_floating",),
                floor("backprop", "floor_read"), lambda v: v <= 3),
+    ]
+
+
+def issue29_targets(rows):
+    """Issue 29: a link frame's Jacobian (its pose included) against Pinocchio's `computeFrameJacobian` and KDL's
+    `ChainJntToJacSolver`, and the node's whole call against the kernel it runs."""
+    faster = lambda q, peer: (lambda r: quotient(r.t(q, peer), r.t(q, "ours")))  # noqa: E731
+    return [
+        target(rows, "Issue 29: frame Jacobian faster than Pinocchio `computeFrameJacobian` (one frame)", ALL,
+               faster("frame_jacobian", "pinocchio"), lambda v: v >= 1),
+        target(rows, "Issue 29: frame Jacobian faster than KDL `ChainJntToJacSolver`", ALL,
+               faster("frame_jacobian", "kdl"), lambda v: v >= 1),
+        target(rows, "Issue 29: the node's whole call (`SceneQueries::frameJacobians`, one frame) ≤ 1.2× the kernel "
+               "it runs", ALL, lambda r: quotient(r.t("frame_jacobian", "node_call"), r.t("frame_jacobian", "ours")),
+               lambda v: v <= 1.2),
     ]

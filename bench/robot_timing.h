@@ -38,5 +38,7 @@ inline void addBenchmark(const std::string& name, std::function<void(benchmark::
 void registerBodyRows(const Robot& robot);
 void registerVertexRows(const Robot& robot);
 void registerDynamicsRows(const Robot& robot);
+/// frame_jacobian and com_jacobian rows (bench_frames.cpp).
+void registerFrameRows(const Robot& robot);
 
 }  // namespace drb_bench

@@ -68,4 +68,26 @@ CenterOfMass PinocchioRobot::centerOfMass(const Eigen::VectorXd& q, const Eigen:
   return { oMi.act(impl_->data.com[id]), J, oMi.rotation() * impl_->data.acom[id] };
 }
 
+std::size_t PinocchioRobot::frameOf(const std::string& link) const
+{
+  if (!impl_->model.existBodyName(link))
+    throw std::invalid_argument("PinocchioRobot::frameOf: no link " + link);
+  return impl_->model.getBodyId(link);
+}
+
+const Matrix6Xd& PinocchioRobot::computeFrameJacobian(const Eigen::VectorXd& q, std::size_t frame, int reference)
+{
+  Matrix6Xd& J = buffer<Matrix6Xd>();
+  if (J.cols() != impl_->model.nv)
+    J.setZero(6, impl_->model.nv);
+  pinocchio::computeFrameJacobian(impl_->model, impl_->data, q, frame, referenceFrame(reference), J);
+  return J;
+}
+
+const Eigen::Matrix3Xd& PinocchioRobot::jacobianCenterOfMass(const Eigen::VectorXd& q)
+{
+  pinocchio::jacobianCenterOfMass(impl_->model, impl_->data, q, false);
+  return impl_->data.Jcom;
+}
+
 }  // namespace drb_pinocchio

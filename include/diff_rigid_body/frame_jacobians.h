@@ -29,6 +29,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "diff_rigid_body/body_workspace.h"
 
@@ -42,6 +43,11 @@ enum class FrameReference : std::uint8_t
   Local = 1,
   LocalWorldAligned = 2,
 };
+
+/// Marks in `needed` (one entry per segment) the segments that frame `link`
+/// (an index into model.links) hangs from: its segment and its ancestors,
+/// all that forwardKinematicsOf must place for frameJacobian without bias.
+void markSupport(const BodyModel& model, std::size_t link, std::vector<char>& needed);
 
 /// Frame `link` (an index into model.links) at the kinematics in ws
 /// (forwardKinematics): its pose (12 values: position, then R_F row-major)

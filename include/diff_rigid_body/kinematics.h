@@ -30,6 +30,7 @@
 
 #include <cmath>
 #include <type_traits>
+#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -161,34 +162,55 @@ void placeFreeRoot(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Scal
 }
 }  // namespace detail
 
-/// Every segment frame (ws.R, ws.p), dof motion (ws.S) and the reference
-/// point (ws.r) at x (model.coordinates values); see the header comment.
-template <typename Scalar>
-void forwardKinematics(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Scalar* x)
+namespace detail
 {
-  detail::jointTrigonometry(model, ws, x);
+/// The root and every later segment s with needed(s) placed at x (a set
+/// closed under parents: a needed segment's parent is needed).
+template <typename Scalar, typename Needed>
+void placeSegments(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Scalar* x, Needed&& needed)
+{
+  jointTrigonometry(model, ws, x);
   const Segment& root = model.segments[0];
   if (root.joint_type == JointType::Free)
-    detail::placeFreeRoot(model, ws, x);
+    placeFreeRoot(model, ws, x);
   else
   {
     const Matrix3<Scalar> Rj = root.placement_rotation.template cast<Scalar>();
     const Vector3<Scalar> pj = root.placement_translation.template cast<Scalar>();
     ws.r = pj;
-    detail::placeJointSegment(model, ws, 0, Rj, pj, x);
+    placeJointSegment(model, ws, 0, Rj, pj, x);
   }
   for (std::size_t s = 1; s < model.segments.size(); ++s)
   {
+    if (!needed(s))
+      continue;
     const Segment& segment = model.segments[s];
     const std::size_t parent = static_cast<std::size_t>(segment.parent);
     const Vector3<Scalar> pj = ws.R[parent] * segment.placement_translation.template cast<Scalar>() + ws.p[parent];
     if (segment.placement_rotates)
-      detail::placeJointSegment(model, ws, s,
-                                Matrix3<Scalar>(ws.R[parent] * segment.placement_rotation.template cast<Scalar>()),
-                                pj, x);
+      placeJointSegment(model, ws, s, Matrix3<Scalar>(ws.R[parent] * segment.placement_rotation.template cast<Scalar>()),
+                        pj, x);
     else
-      detail::placeJointSegment(model, ws, s, Matrix3<Scalar>(ws.R[parent]), pj, x);
+      placeJointSegment(model, ws, s, Matrix3<Scalar>(ws.R[parent]), pj, x);
   }
+}
+}  // namespace detail
+
+/// Every segment frame (ws.R, ws.p), dof motion (ws.S) and the reference
+/// point (ws.r) at x (model.coordinates values); see the header comment.
+template <typename Scalar>
+void forwardKinematics(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Scalar* x)
+{
+  detail::placeSegments(model, ws, x, [](std::size_t) { return true; });
+}
+
+/// forwardKinematics of the segments with needed[s] != 0 only (closed under
+/// parents, e.g. the path from the root to the links asked for: what a
+/// frame's pose and Jacobian read); the other segments' entries are stale.
+inline void forwardKinematicsOf(const BodyModel& model, BodyWorkspace<double>& ws, const double* x,
+                                const std::vector<char>& needed)
+{
+  detail::placeSegments(model, ws, x, [&](std::size_t s) { return needed[s] != 0; });
 }
 
 /// Whether every frame, unit motion and the reference point are finite (a

@@ -321,6 +321,8 @@ private:
   /// Independent joint name -> (body, x index), and the names of mimic joints.
   std::unordered_map<std::string, std::pair<std::size_t, std::size_t>> joint_index_;
   std::unordered_set<std::string> mimic_joints_;
+  /// Link name -> (body, index in its links), for frame requests.
+  std::unordered_map<std::string, std::pair<std::size_t, std::size_t>> link_index_;
   /// Tells this object's workspaces from another's in a thread's cache (never reused).
   std::uint64_t id_;
 };

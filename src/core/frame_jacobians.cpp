@@ -40,13 +40,18 @@ void writePose(const Matrix3<double>& R, const Vector3<double>& p, double* pose1
 }
 
 /// J_c = (V_c + W_c x (P - r), W_c) from the prepared columns, in fixed axes
-/// or, for LOCAL, in R's (6 x d row-major).
-void writeJacobian(const BodyWorkspace<double>& ws, std::size_t d, const Vector3<double>& lever, bool local,
-                   const Matrix3<double>& R, double* J)
+/// or, for LOCAL, in R's (6 x d row-major): zeros, then the columns of the
+/// dofs that segment s hangs from (the only nonzero ones).
+void writeJacobian(const BodyModel& model, const BodyWorkspace<double>& ws, std::size_t s,
+                   const Vector3<double>& lever, bool local, const Matrix3<double>& R, double* J)
 {
+  const std::size_t d = model.coordinates;
+  std::fill(J, J + 6 * d, 0.0);
   const double* rows = ws.column_motion.data();
-  for (std::size_t c = 0; c < d; ++c)
+  const Segment& segment = model.segments[s];
+  for (int k = segment.first_dof + segment.dof_count - 1; k >= 0; k = model.dofs[static_cast<std::size_t>(k)].parent)
   {
+    const std::size_t c = static_cast<std::size_t>(model.dofs[static_cast<std::size_t>(k)].coordinate);
     const Vector3<double> W(rows[3 * d + c], rows[4 * d + c], rows[5 * d + c]);
     Vector3<double> linear = Vector3<double>(rows[c], rows[d + c], rows[2 * d + c]) + W.cross(lever);
     Vector3<double> angular = W;
@@ -63,6 +68,12 @@ void writeJacobian(const BodyWorkspace<double>& ws, std::size_t d, const Vector3
   }
 }
 }  // namespace
+
+void markSupport(const BodyModel& model, std::size_t link, std::vector<char>& needed)
+{
+  for (int s = static_cast<int>(model.links[link].segment); s >= 0; s = model.segments[static_cast<std::size_t>(s)].parent)
+    needed[static_cast<std::size_t>(s)] = 1;
+}
 
 void frameMotion(const BodyModel& model, BodyWorkspace<double>& ws, const double* xd)
 {
@@ -85,7 +96,7 @@ void frameJacobian(const BodyModel& model, BodyWorkspace<double>& ws, std::size_
   if (jacobian)
   {
     detail::prepareSegmentColumns(model, ws, allColumns(model), s);
-    writeJacobian(ws, model.coordinates, lever, local, R, jacobian);
+    writeJacobian(model, ws, s, lever, local, R, jacobian);
   }
   if (!bias)
     return;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <unordered_map>
 
 #include "diff_rigid_body/frame_jacobians.h"
 #include "diff_rigid_body/kinematics.h"
@@ -42,11 +43,14 @@ std::string listed(const Names& names)
   return out;
 }
 
-/// The slots of `frames` (empty = every link of the body), or a refusal
-/// naming the unknown frame and the body's links.
-void frameSlots(const Scene& scene, const BodyModel& body, const std::vector<std::string>& frames,
+/// The slots of `frames` (empty = every link of the body `body_index`), or a
+/// refusal naming the unknown frame and the body's links; `links` maps a
+/// link name to (body, link index).
+void frameSlots(const Scene& scene, std::size_t body_index, const std::vector<std::string>& frames,
+                const std::unordered_map<std::string, std::pair<std::size_t, std::size_t>>& links,
                 std::vector<FrameSlot>& slots)
 {
+  const BodyModel& body = scene.bodies[body_index];
   slots.clear();
   if (frames.empty())
   {
@@ -59,18 +63,10 @@ void frameSlots(const Scene& scene, const BodyModel& body, const std::vector<std
                                 frames.size()));
   for (std::size_t f = 0; f < frames.size(); ++f)
   {
-    const auto in_body = std::find_if(body.links.begin(), body.links.end(),
-                                      [&](const LinkInBody& link) { return link.name == frames[f]; });
-    if (in_body != body.links.end())
+    const auto link = links.find(frames[f]);
+    if (link != links.end() && link->second.first == body_index)
     {
-      slots.push_back({ static_cast<std::size_t>(in_body - body.links.begin()), false });
-      continue;
-    }
-    const auto fixed = std::find_if(scene.static_links.begin(), scene.static_links.end(),
-                                    [&](const StaticLink& link) { return link.name == frames[f]; });
-    if (fixed != scene.static_links.end())
-    {
-      slots.push_back({ static_cast<std::size_t>(fixed - scene.static_links.begin()), true });
+      slots.push_back({ link->second.second, false });
       continue;
     }
     if (frames[f] == scene.fixed_frame)
@@ -78,11 +74,20 @@ void frameSlots(const Scene& scene, const BodyModel& body, const std::vector<std
       slots.push_back({ kFixedFrame, true });
       continue;
     }
+    const auto fixed = std::find_if(scene.static_links.begin(), scene.static_links.end(),
+                                    [&](const StaticLink& s) { return s.name == frames[f]; });
+    if (fixed != scene.static_links.end())
+    {
+      slots.push_back({ static_cast<std::size_t>(fixed - scene.static_links.begin()), true });
+      continue;
+    }
     const std::string name = frames[f].size() > 64 ? frames[f].substr(0, 64) + "..." : frames[f];
+    const std::string elsewhere =
+        link == links.end() ? "" : " (it is a link of body '" + scene.bodies[link->second.first].name + "')";
     reject("frames[" + std::to_string(f) + "]: unknown frame '" + name + "': not a link of body '" + body.name +
            "' (its links: " + listed(body.links) + "), a static link" +
            (scene.static_links.empty() ? "" : " (" + listed(scene.static_links) + ")") + " or the fixed frame '" +
-           scene.fixed_frame + "'");
+           scene.fixed_frame + "'" + elsewhere);
   }
 }
 
@@ -118,7 +123,7 @@ void SceneQueries::frameJacobians(const SceneState& current, const std::string& 
   const std::size_t index = bodyIndex(body_name, "body");
   const BodyModel& body = scene_.bodies[index];
   thread_local std::vector<FrameSlot> slots;
-  frameSlots(scene_, body, frames, slots);
+  frameSlots(scene_, index, frames, link_index_, slots);
   const FrameReference ref = frameReference(reference);
   thread_local std::vector<std::size_t> indices;
   indices.assign(1, index);
@@ -137,10 +142,15 @@ void SceneQueries::frameJacobians(const SceneState& current, const std::string& 
   answer.acceleration_bias.resize(acceleration_bias ? K * F * 6 : 0);
   answer.cos_theta.resize(K);
   BodyWorkspace<double>& ws = workspace(index);
+  thread_local std::vector<char> needed;  // without the bias: only the listed frames' paths
+  needed.assign(body.segments.size(), acceleration_bias ? 1 : 0);
+  for (const FrameSlot& slot : slots)
+    if (!slot.fixed)
+      markSupport(body, slot.index, needed);
   for (std::size_t k = 0; k < K; ++k)
   {
     const double* x = q.empty() ? current[index].data() : q.data() + k * d;
-    forwardKinematics(body, ws, x);
+    forwardKinematicsOf(body, ws, x, needed);
     if (acceleration_bias)
       frameMotion(body, ws, slice(qdot, k * d));
     for (std::size_t f = 0; f < F; ++f)

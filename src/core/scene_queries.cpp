@@ -67,6 +67,9 @@ SceneQueries::SceneQueries(Scene scene, const Eigen::Vector3d& gravity)
     for (const Segment& segment : body.segments)
       if (segment.joint_type != JointType::Free && joint_index_.count(segment.joint) == 0)
         mimic_joints_.insert(segment.joint);
+  for (std::size_t i = 0; i < scene_.bodies.size(); ++i)
+    for (std::size_t l = 0; l < scene_.bodies[i].links.size(); ++l)
+      link_index_.emplace(scene_.bodies[i].links[l].name, std::make_pair(i, l));
 }
 
 BodyWorkspace<double>& SceneQueries::workspace(std::size_t index) const
