@@ -23,6 +23,7 @@
 
 #include "diff_rigid_body/forward_dynamics.h"
 #include "../support/dynamics_fixtures.h"
+#include "../support/peer_joints.h"
 #include "../support/mujoco_model.h"
 
 namespace drb = diff_rigid_body;
@@ -40,39 +41,9 @@ const Eigen::Vector3d kGravity(0.4, -0.3, -9.81);
 using Matrix = Eigen::MatrixXd;
 using Vector = Eigen::VectorXd;
 
-const drb_test::dynamics::DynamicsBody& fixture(const std::string& name)
-{
-  for (const auto& f : dynamicsBodies())
-    if (f.name == name)
-      return f;
-  throw std::runtime_error("no fixture " + name);
-}
-
-/// The URDF file and chain tip of a fixed-base fixture.
-const drb_test::articulated::Fixture& spec(const std::string& name)
-{
-  static const std::vector<drb_test::articulated::Fixture> all = drb_test::articulated::fixedBaseFixtures();
-  for (const auto& f : all)
-    if (name == f.name)
-      return f;
-  throw std::runtime_error("no fixed-base fixture " + name);
-}
-
-/// x index, multiplier and offset of a 1-dof joint of `model`, by name.
-bool coordinateOf(const drb::BodyModel& model, const std::string& joint, int& coordinate, double& multiplier,
-                  double& offset)
-{
-  for (const drb::Segment& segment : model.segments)
-    if (segment.joint == joint && segment.joint_type != drb::JointType::Free)
-    {
-      const drb::Dof& dof = model.dofs[static_cast<std::size_t>(segment.first_dof)];
-      coordinate = dof.coordinate;
-      multiplier = dof.multiplier;
-      offset = segment.offset;
-      return true;
-    }
-  return false;
-}
+using drb_test::peers::coordinateOf;
+using drb_test::peers::fixture;
+using drb_test::peers::spec;
 
 struct OurTerms
 {
@@ -105,20 +76,11 @@ TEST_P(KdlChains, RneCoriolisAndGravity)
 {
   const auto& f = fixture(GetParam());
   const drb::BodyModel& model = f.model();
-  const std::string tip = spec(f.name).tip;
-  const auto urdf_model = urdf::parseURDFFile(spec(f.name).path);
-  KDL::Tree tree;
-  ASSERT_TRUE(kdl_parser::treeFromUrdfModel(*urdf_model, tree));
-  const std::string base = urdf_model->getLink(model.name)->getParent()->name;
-  KDL::Chain chain;
-  ASSERT_TRUE(tree.getChain(base, tip, chain));
+  const drb_test::peers::KdlChain kdl = drb_test::peers::kdlChain(f);
+  const KDL::Chain& chain = kdl.chain;
   ASSERT_EQ(chain.getNrOfJoints(), model.coordinates) << "the chain must carry every coordinate";
   // Gravity in the chain base's axes: the base is a static link, posed in the fixed frame.
-  Eigen::Matrix3d R_base = Eigen::Matrix3d::Identity();
-  for (const drb::StaticLink& link : f.scene.static_links)
-    if (link.name == base)
-      R_base = link.pose_in_fixed_frame.linear();
-  const Eigen::Vector3d g_base = R_base.transpose() * kGravity;
+  const Eigen::Vector3d g_base = kdl.R_base.transpose() * kGravity;
   const KDL::Vector gravity(g_base[0], g_base[1], g_base[2]);
   std::mt19937_64 rng(3);
   for (int trial = 0; trial < 3; ++trial)
@@ -172,18 +134,10 @@ TEST_P(MujocoRobots, InverseAndForwardDynamics)
     mm.dof_damping[i] = mm.dof_armature[i] = mm.dof_frictionloss[i] = 0;
   mm.opt.disableflags |= mjDSBL_CONSTRAINT;  // the Panda's joint limits would add constraint forces
   const Eigen::Index d = static_cast<Eigen::Index>(model.coordinates);
-  Matrix A = Matrix::Zero(mm.nv, d);
-  Vector offset = Vector::Zero(mm.nv);
-  std::vector<int> qpos_of(static_cast<std::size_t>(mm.nv));
-  for (int j = 0; j < mm.njnt; ++j)
-  {
-    int c = -1;
-    double multiplier = 1, joint_offset = 0;
-    ASSERT_TRUE(coordinateOf(model, mj_id2name(&mm, mjOBJ_JOINT, j), c, multiplier, joint_offset));
-    A(mm.jnt_dofadr[j], c) = multiplier;
-    offset[mm.jnt_dofadr[j]] = joint_offset;
-    qpos_of[static_cast<std::size_t>(mm.jnt_dofadr[j])] = mm.jnt_qposadr[j];
-  }
+  const drb_test::peers::MujocoJoints joints = drb_test::peers::mujocoJoints(mm, model);
+  const Matrix& A = joints.A;
+  const Vector& offset = joints.offset;
+  const std::vector<int>& qpos_of = joints.qpos_of;
   std::mt19937_64 rng(5);
   mjData& data = mj.data();
   for (int trial = 0; trial < 3; ++trial)

@@ -22,6 +22,7 @@
 
 #include "diff_rigid_body/scene_queries.h"
 #include "../support/dynamics_fixtures.h"
+#include "../support/peer_joints.h"
 #include "../support/mujoco_model.h"
 
 namespace drb = diff_rigid_body;
@@ -35,38 +36,9 @@ using Matrix = Eigen::MatrixXd;
 using Vector = Eigen::VectorXd;
 using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
-const drb_test::dynamics::DynamicsBody& fixture(const std::string& name)
-{
-  for (const auto& f : dynamicsBodies())
-    if (f.name == name)
-      return f;
-  throw std::runtime_error("no fixture " + name);
-}
-
-const drb_test::articulated::Fixture& spec(const std::string& name)
-{
-  static const std::vector<drb_test::articulated::Fixture> all = drb_test::articulated::fixedBaseFixtures();
-  for (const auto& f : all)
-    if (name == f.name)
-      return f;
-  throw std::runtime_error("no fixed-base fixture " + name);
-}
-
-/// The x index and multiplier of the 1-dof joint `joint`, and its offset.
-bool coordinateOf(const drb::BodyModel& model, const std::string& joint, int& coordinate, double& multiplier,
-                  double& offset)
-{
-  for (const drb::Segment& segment : model.segments)
-    if (segment.joint == joint && segment.joint_type != drb::JointType::Free)
-    {
-      const drb::Dof& dof = model.dofs[static_cast<std::size_t>(segment.first_dof)];
-      coordinate = dof.coordinate;
-      multiplier = dof.multiplier;
-      offset = segment.offset;
-      return true;
-    }
-  return false;
-}
+using drb_test::peers::coordinateOf;
+using drb_test::peers::fixture;
+using drb_test::peers::spec;
 
 /// Our answer for `frames` of the fixture's body at one configuration.
 drb::FrameJacobianAnswer ourFrames(const drb_test::dynamics::DynamicsBody& f, const std::vector<std::string>& frames,
@@ -93,18 +65,10 @@ TEST_P(KdlFrames, TipJacobianAndItsRate)
   const auto& f = fixture(GetParam());
   const drb::BodyModel& model = f.model();
   const std::string tip = spec(f.name).tip;
-  const auto urdf_model = urdf::parseURDFFile(spec(f.name).path);
-  KDL::Tree tree;
-  ASSERT_TRUE(kdl_parser::treeFromUrdfModel(*urdf_model, tree));
-  const std::string base = urdf_model->getLink(model.name)->getParent()->name;
-  KDL::Chain chain;
-  ASSERT_TRUE(tree.getChain(base, tip, chain));
-  Eigen::Matrix3d R_base = Eigen::Matrix3d::Identity();  // the chain base's axes in the fixed frame
-  for (const drb::StaticLink& link : f.scene.static_links)
-    if (link.name == base)
-      R_base = link.pose_in_fixed_frame.linear();
-  Matrix rotate = Matrix::Zero(6, 6);
-  rotate.topLeftCorner(3, 3) = rotate.bottomRightCorner(3, 3) = R_base;
+  const drb_test::peers::KdlChain kdl = drb_test::peers::kdlChain(f);
+  const KDL::Chain& chain = kdl.chain;
+  Matrix rotate = Matrix::Zero(6, 6);  // KDL answers in the chain base's axes
+  rotate.topLeftCorner(3, 3) = rotate.bottomRightCorner(3, 3) = kdl.R_base;
   const Eigen::Index d = static_cast<Eigen::Index>(model.coordinates);
   std::mt19937_64 rng(29);
   for (int trial = 0; trial < 3; ++trial)
@@ -150,18 +114,9 @@ TEST_P(MujocoFrames, BodyJacobiansAndSubtreeCom)
   const mjModel& mm = mj.model();
   mjData& data = mj.data();
   const Eigen::Index d = static_cast<Eigen::Index>(model.coordinates);
-  Matrix A = Matrix::Zero(mm.nv, d);
-  Vector offset = Vector::Zero(mm.nv);
-  std::vector<int> qpos_of(static_cast<std::size_t>(mm.nv));
-  for (int j = 0; j < mm.njnt; ++j)
-  {
-    int c = -1;
-    double multiplier = 1, joint_offset = 0;
-    ASSERT_TRUE(coordinateOf(model, mj_id2name(&mm, mjOBJ_JOINT, j), c, multiplier, joint_offset));
-    A(mm.jnt_dofadr[j], c) = multiplier;
-    offset[mm.jnt_dofadr[j]] = joint_offset;
-    qpos_of[static_cast<std::size_t>(mm.jnt_dofadr[j])] = mm.jnt_qposadr[j];
-  }
+  const drb_test::peers::MujocoJoints joints = drb_test::peers::mujocoJoints(mm, model);
+  const Matrix& A = joints.A;
+  const std::vector<int>& qpos_of = joints.qpos_of;
   std::vector<std::string> kept;  // our links that MuJoCo keeps as bodies (fusestatic merges the others)
   for (const drb::LinkInBody& link : model.links)
     if (mj.body(link.name) >= 0)
@@ -172,7 +127,7 @@ TEST_P(MujocoFrames, BodyJacobiansAndSubtreeCom)
   for (int trial = 0; trial < 3; ++trial)
   {
     const auto m = drb_test::dynamics::randomMotion(model, rng);
-    const Vector q = A * m.x + offset;
+    const Vector q = A * m.x + joints.offset;
     for (int i = 0; i < mm.nv; ++i)
       data.qpos[qpos_of[std::size_t(i)]] = q[i];
     mj_kinematics(&mm, &data);
