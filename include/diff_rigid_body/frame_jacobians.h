@@ -50,7 +50,7 @@ enum class FrameReference : std::uint8_t
 void markSupport(const BodyModel& model, std::size_t link, std::vector<char>& needed);
 
 /// Frame `link` (an index into model.links) at the kinematics in ws
-/// (forwardKinematics): its pose (12 values: position, then R_F row-major)
+/// (forwardKinematics, or forwardKinematicsOf over markSupport): its pose (12 values: position, then R_F row-major)
 /// into pose12, its Jacobian (6 x d row-major) into jacobian unless null,
 /// and its classical acceleration bias (6) into bias unless null, which
 /// needs the motion of frameMotion at (x, x').
@@ -59,7 +59,8 @@ void frameJacobian(const BodyModel& model, BodyWorkspace<double>& ws, std::size_
 
 /// The segment velocities and accelerations at x'' = 0 without gravity
 /// (ws.dof_velocity, ws.dof_acceleration) at (x, x') from the kinematics in
-/// ws, for the biases; null xd means zeros.
+/// ws, which must be forwardKinematics' (every segment: the pass reads every
+/// dof's motion), for the biases; null xd means zeros.
 void frameMotion(const BodyModel& model, BodyWorkspace<double>& ws, const double* xd);
 
 /// The body's centre of mass at x into com (3, fixed frame), its Jacobian

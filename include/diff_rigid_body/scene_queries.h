@@ -264,12 +264,14 @@ public:
   /// LOCAL_WORLD_ALIGNED; frame_jacobians.h) and, when `acceleration_bias`,
   /// the classical acceleration biases of the link frames `frames` of
   /// `body` (empty = every link of the body, in model.links order; a static
-  /// link: fixed pose, zero columns and bias), at K configurations (q: K d
-  /// values; empty = the current state) with qdot of q's length or empty
-  /// (zeros). Refused, before anything is computed: an unknown body or
-  /// frame (naming it and the known ones), an unknown reference, lengths
-  /// that do not match, non-finite values, an answer over
-  /// RequestLimits::kMaxMassMatrixDoubles; after: a result that is not finite.
+  /// link or the fixed frame, by its URDF name: fixed pose, zero columns and
+  /// bias), at K configurations (q: K d values; empty = the current state)
+  /// with qdot of q's length or empty (zeros). Without the bias only the
+  /// listed frames' paths are placed (forwardKinematicsOf). Refused, before
+  /// anything is computed: an unknown body or frame (naming it and the known
+  /// ones), an unknown reference, lengths that do not match, non-finite
+  /// values, an answer over RequestLimits::kMaxMassMatrixDoublesWithDerivatives;
+  /// after: a result that is not finite.
   void frameJacobians(const SceneState& current, const std::string& body, const std::vector<std::string>& frames,
                       const std::vector<double>& q, const std::vector<double>& qdot, std::uint32_t reference,
                       bool acceleration_bias, FrameJacobianAnswer& answer) const;

@@ -136,7 +136,7 @@ double centerOfMass(const BodyModel& model, BodyWorkspace<double>& ws, const dou
     {
       const Dof& dof = model.dofs[k];
       const Force<double> F = spatial::momentum(ws.composite[static_cast<std::size_t>(dof.segment)], ws.S[k]);
-      J.col(dof.coordinate) += (dof.multiplier / mass) * F.f;
+      J.col(dof.coordinate) += (dof.multiplier * F.f) / mass;  // m / m is exactly 1: a free body's dc/dt = I
     }
     columnsToCoordinates(model, ws, J);
   }

@@ -133,7 +133,7 @@ class Frames(unittest.TestCase):
         for field in ('masses', 'com', 'J', 'bias', 'cos_theta'):
             self.assertTrue(np.array_equal(getattr(ours, field), getattr(one, field)), field)
 
-    def test_f_a_static_link_is_a_frame_with_zero_columns(self):
+    def test_f_the_fixed_frame_is_a_frame_with_zero_columns(self):
         static = [name for name in self.urdf_links() if name not in {link.name for link in self.links}]
         self.assertEqual(static, ['panda_link0'])  # the root link: the fixed frame
         answer = self.client.frame_jacobians(self.body, q=self.random_x(), frames=static, acceleration_bias=True)
@@ -151,8 +151,8 @@ class Frames(unittest.TestCase):
             (dict(body=self.body, q=x, frames=['panda_link4', 'no_such_link']),
              ["frames[1]", "unknown frame 'no_such_link'", 'panda_link4']),
             (dict(body='no_such_body', q=x), ["unknown body 'no_such_body'"]),
-            (dict(body=self.body, q=x[:-1]), ['q']),
-            (dict(body=self.body, q=np.where(np.arange(self.d) == 2, np.nan, x)), ['q', 'finite']),
+            (dict(body=self.body, q=x[:-1]), ['q: expected a multiple of %d values' % self.d]),
+            (dict(body=self.body, q=np.where(np.arange(self.d) == 2, np.nan, x)), ['q[2]: not finite (nan)']),
         ]
         for kwargs, phrases in cases:
             with self.assertRaises(DiffRigidBodyError) as caught:

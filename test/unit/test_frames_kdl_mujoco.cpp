@@ -11,6 +11,7 @@
 //   body's centre of mass, on the Panda and the UR5. MuJoCo ignores
 //   <mimic>: our coordinate c drives its joint j as q_j = A(j, c) x_c + o_j,
 //   so our Jacobian is MuJoCo's times A.
+#include <algorithm>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -154,6 +155,39 @@ TEST_P(MujocoFrames, BodyJacobiansAndSubtreeCom)
         << f.name << ": subtree_com";
     EXPECT_LT(relativeDifference(Eigen::Map<const RowMajor>(com.jacobians.data(), 3, d), Matrix(jacp * A)), kAgreement)
         << f.name << ": mj_jacSubtreeCom";
+  }
+}
+
+TEST(FramePaths, ASubsetWithoutBiasHasTheBitsOfFullKinematics)
+{
+  // Without the bias a request places only its frames' paths
+  // (forwardKinematicsOf): after a request for other frames on the same
+  // thread, no entry it reads may be stale.
+  for (const char* name : { "panda", "floating_humanoid" })
+  {
+    const auto& f = fixture(name);
+    const drb::BodyModel& model = f.model();
+    const drb::SceneQueries queries(f.scene);
+    std::mt19937_64 rng(37);
+    const auto m = drb_test::dynamics::randomMotion(model, rng);
+    const std::vector<double> x(m.x.data(), m.x.data() + m.x.size());
+    const std::size_t last = model.links.size() - 1, middle = model.links.size() / 2;
+    const std::vector<std::string> subset{ model.links[1].name, model.links[middle].name };
+    drb::FrameJacobianAnswer full, other, partial;
+    queries.frameJacobians(queries.initialState(), model.name, {}, x, {}, 0, true, full);
+    queries.frameJacobians(queries.initialState(), model.name, { model.links[last].name }, x, {}, 0, false, other);
+    queries.frameJacobians(queries.initialState(), model.name, subset, x, {}, 0, false, partial);
+    const std::size_t d = model.coordinates;
+    for (std::size_t k = 0; k < subset.size(); ++k)
+    {
+      const std::size_t l = k == 0 ? 1 : middle;
+      EXPECT_TRUE(std::equal(partial.poses.begin() + 12 * k, partial.poses.begin() + 12 * (k + 1),
+                             full.poses.begin() + 12 * l))
+          << name << ": pose of " << subset[k];
+      EXPECT_TRUE(std::equal(partial.jacobians.begin() + 6 * d * k, partial.jacobians.begin() + 6 * d * (k + 1),
+                             full.jacobians.begin() + 6 * d * l))
+          << name << ": J of " << subset[k];
+    }
   }
 }
 
