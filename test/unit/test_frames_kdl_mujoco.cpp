@@ -169,13 +169,17 @@ TEST(FramePaths, ASubsetWithoutBiasHasTheBitsOfFullKinematics)
     const drb::BodyModel& model = f.model();
     const drb::SceneQueries queries(f.scene);
     std::mt19937_64 rng(37);
-    const auto m = drb_test::dynamics::randomMotion(model, rng);
+    const auto m = drb_test::dynamics::randomMotion(model, rng), elsewhere = drb_test::dynamics::randomMotion(model, rng);
     const std::vector<double> x(m.x.data(), m.x.data() + m.x.size());
+    const std::vector<double> x2(elsewhere.x.data(), elsewhere.x.data() + elsewhere.x.size());
     const std::size_t last = model.links.size() - 1, middle = model.links.size() / 2;
     const std::vector<std::string> subset{ model.links[1].name, model.links[middle].name };
     drb::FrameJacobianAnswer full, other, partial;
     queries.frameJacobians(queries.initialState(), model.name, {}, x, {}, 0, true, full);
-    queries.frameJacobians(queries.initialState(), model.name, { model.links[last].name }, x, {}, 0, false, other);
+    // Every segment of this thread's workspace at another configuration x2,
+    // so that an entry the subset's request leaves unplaced would differ.
+    queries.frameJacobians(queries.initialState(), model.name, {}, x2, {}, 0, true, other);
+    queries.frameJacobians(queries.initialState(), model.name, { model.links[last].name }, x2, {}, 0, false, other);
     queries.frameJacobians(queries.initialState(), model.name, subset, x, {}, 0, false, partial);
     const std::size_t d = model.coordinates;
     for (std::size_t k = 0; k < subset.size(); ++k)
