@@ -57,70 +57,109 @@ struct NamedState
   Eigen::VectorXd x = Eigen::VectorXd::Zero(6);
 };
 
-/// Matrices in configuration-major order, then the listed bodies' order:
-/// matrix (k, i) for configuration k and listed body i, d_i = dofs[i].
+// The batched answers, each declared from one list of its fields,
+// X(type, name), named and ordered as in its .srv response. DRB_ANSWER
+// declares the fields and moveInto(response), which moves each field into the
+// member of the same name of any struct that has them (the node's srv
+// response): a field is named once, here, for the core and the node.
+#define DRB_ANSWER_FIELD(type, name) type name{};
+#define DRB_ANSWER_MOVE(type, name) response.name = std::move(name);
+#define DRB_ANSWER(FIELDS)                                                                                             \
+  FIELDS(DRB_ANSWER_FIELD)                                                                                             \
+  template <typename Response>                                                                                         \
+  void moveInto(Response& response)                                                                                    \
+  {                                                                                                                    \
+    FIELDS(DRB_ANSWER_MOVE)                                                                                            \
+  }
+
+/// ~get_mass_matrix: matrices in configuration-major order, then the listed
+/// bodies' order: matrix (k, i) for configuration k and listed body i,
+/// d_i = dofs[i]. mass_matrices: d_i^2 per matrix, row-major; derivatives:
+/// d_i^3 per matrix when asked, dM/dx_j for j = 0..d_i-1, d_i^2 row-major
+/// each; cos_theta: one per matrix, cos(theta) of a free body or floating
+/// root (0 at gimbal lock), 1 for a fixed-base body (no Euler angles).
+#define DRB_MASS_MATRIX_ANSWER_FIELDS(X)                                                                               \
+  X(std::vector<std::string>, bodies)                                                                                  \
+  X(std::vector<std::uint32_t>, dofs)                                                                                  \
+  X(std::vector<double>, mass_matrices)                                                                                \
+  X(std::vector<double>, derivatives)                                                                                  \
+  X(std::vector<double>, cos_theta)
 struct MassMatrixAnswer
 {
-  std::vector<std::string> bodies;
-  std::vector<std::uint32_t> dofs;    ///< d_i per listed body
-  std::vector<double> mass_matrices;  ///< d_i^2 per matrix, row-major
-  std::vector<double> derivatives;    ///< d_i^3 per matrix when asked: dM/dx_j, j = 0..d_i-1, d_i^2 row-major each
-  /// One per matrix: cos(theta) of a free body or floating root (0 at gimbal
-  /// lock); 1 for a fixed-base body (no Euler angles).
-  std::vector<double> cos_theta;
+  DRB_ANSWER(DRB_MASS_MATRIX_ANSWER_FIELDS)
 };
 
-/// ~inverse_dynamics' answer, laid out as MassMatrixAnswer: per configuration
-/// k and listed body i, vectors of d_i values at k D + (sum of the d before
-/// i) and matrices of d_i^2 (row-major) at k sum(d^2) + (sum of the d^2 before i).
+/// ~inverse_dynamics, laid out as MassMatrixAnswer: per configuration k and
+/// listed body i, vectors of d_i values at k D + (sum of the d before i) and
+/// matrices of d_i^2 (row-major) at k sum(d^2) + (sum of the d^2 before i).
+/// tau = M x'' + c + g, velocity_terms c = C x', gravity_terms g; when asked,
+/// coriolis_matrices C, dtau_dq and dtau_dqdot (= 2 C); cos_theta per
+/// matrix slot, as MassMatrixAnswer.
+#define DRB_INVERSE_DYNAMICS_ANSWER_FIELDS(X)                                                                          \
+  X(std::vector<std::string>, bodies)                                                                                  \
+  X(std::vector<std::uint32_t>, dofs)                                                                                  \
+  X(std::vector<double>, tau)                                                                                          \
+  X(std::vector<double>, velocity_terms)                                                                               \
+  X(std::vector<double>, gravity_terms)                                                                                \
+  X(std::vector<double>, coriolis_matrices)                                                                            \
+  X(std::vector<double>, dtau_dq)                                                                                      \
+  X(std::vector<double>, dtau_dqdot)                                                                                   \
+  X(std::vector<double>, cos_theta)
 struct InverseDynamicsAnswer
 {
-  std::vector<std::string> bodies;
-  std::vector<std::uint32_t> dofs;
-  std::vector<double> tau;                ///< M x'' + c + g
-  std::vector<double> velocity_terms;     ///< c = C x'
-  std::vector<double> gravity_terms;      ///< g
-  std::vector<double> coriolis_matrices;  ///< C, when asked
-  std::vector<double> dtau_dq;            ///< when asked
-  std::vector<double> dtau_dqdot;         ///< when asked (= 2 C)
-  std::vector<double> cos_theta;          ///< per matrix slot, as MassMatrixAnswer
+  DRB_ANSWER(DRB_INVERSE_DYNAMICS_ANSWER_FIELDS)
 };
 
-/// ~forward_dynamics' answer, laid out as InverseDynamicsAnswer.
+/// ~forward_dynamics, laid out as InverseDynamicsAnswer: qddot =
+/// M^-1 (tau - c - g); when asked dqddot_dq, dqddot_dqdot and dqddot_dtau
+/// (= M^-1).
+#define DRB_FORWARD_DYNAMICS_ANSWER_FIELDS(X)                                                                          \
+  X(std::vector<std::string>, bodies)                                                                                  \
+  X(std::vector<std::uint32_t>, dofs)                                                                                  \
+  X(std::vector<double>, qddot)                                                                                        \
+  X(std::vector<double>, dqddot_dq)                                                                                    \
+  X(std::vector<double>, dqddot_dqdot)                                                                                 \
+  X(std::vector<double>, dqddot_dtau)                                                                                  \
+  X(std::vector<double>, cos_theta)
 struct ForwardDynamicsAnswer
 {
-  std::vector<std::string> bodies;
-  std::vector<std::uint32_t> dofs;
-  std::vector<double> qddot;         ///< M^-1 (tau - c - g)
-  std::vector<double> dqddot_dq;     ///< when asked
-  std::vector<double> dqddot_dqdot;  ///< when asked
-  std::vector<double> dqddot_dtau;   ///< M^-1, when asked
-  std::vector<double> cos_theta;
+  DRB_ANSWER(DRB_FORWARD_DYNAMICS_ANSWER_FIELDS)
 };
 
-/// ~get_frame_jacobians' answer: per configuration k and listed frame f
+/// ~get_frame_jacobians: per configuration k and listed frame f
 /// (frame-major within a configuration), slot n = k F + f of F frames.
+/// dofs: d of the body; poses: 12 per slot, the position, then the rotation
+/// row-major; jacobians: 6 d per slot, row-major, rows linear then angular;
+/// acceleration_bias: 6 per slot, when asked; cos_theta: one per
+/// configuration, as MassMatrixAnswer.
+#define DRB_FRAME_JACOBIAN_ANSWER_FIELDS(X)                                                                            \
+  X(std::vector<std::string>, frames)                                                                                  \
+  X(std::uint32_t, dofs)                                                                                               \
+  X(std::vector<double>, poses)                                                                                        \
+  X(std::vector<double>, jacobians)                                                                                    \
+  X(std::vector<double>, acceleration_bias)                                                                            \
+  X(std::vector<double>, cos_theta)
 struct FrameJacobianAnswer
 {
-  std::vector<std::string> frames;
-  std::uint32_t dofs = 0;                 ///< d of the body
-  std::vector<double> poses;              ///< 12 per slot: position, then the rotation row-major
-  std::vector<double> jacobians;          ///< 6 d per slot, row-major, rows linear then angular
-  std::vector<double> acceleration_bias;  ///< 6 per slot, when asked
-  std::vector<double> cos_theta;          ///< one per configuration, as MassMatrixAnswer
+  DRB_ANSWER(DRB_FRAME_JACOBIAN_ANSWER_FIELDS)
 };
 
-/// ~get_center_of_mass' answer: per configuration k and listed body i
-/// (body-major within a configuration), slot n = k n_bodies + i.
+/// ~get_center_of_mass: per configuration k and listed body i (body-major
+/// within a configuration), slot n = k n_bodies + i. masses per listed body
+/// [kg]; com: 3 per slot, fixed frame [m]; when asked, jacobians (3 d_i per
+/// slot, row-major) and acceleration_bias (3 per slot [m/s^2]); cos_theta
+/// per slot.
+#define DRB_CENTER_OF_MASS_ANSWER_FIELDS(X)                                                                            \
+  X(std::vector<std::string>, bodies)                                                                                  \
+  X(std::vector<std::uint32_t>, dofs)                                                                                  \
+  X(std::vector<double>, masses)                                                                                       \
+  X(std::vector<double>, com)                                                                                          \
+  X(std::vector<double>, jacobians)                                                                                    \
+  X(std::vector<double>, acceleration_bias)                                                                            \
+  X(std::vector<double>, cos_theta)
 struct CenterOfMassAnswer
 {
-  std::vector<std::string> bodies;
-  std::vector<std::uint32_t> dofs;
-  std::vector<double> masses;             ///< per listed body [kg]
-  std::vector<double> com;                ///< 3 per slot, fixed frame [m]
-  std::vector<double> jacobians;          ///< 3 d_i per slot, row-major, when asked
-  std::vector<double> acceleration_bias;  ///< 3 per slot, when asked [m/s^2]
-  std::vector<double> cos_theta;          ///< per slot
+  DRB_ANSWER(DRB_CENTER_OF_MASS_ANSWER_FIELDS)
 };
 
 /// Standard gravity in the fixed frame, -9.81 m/s^2 along z (~gravity's default).

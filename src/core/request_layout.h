@@ -3,6 +3,7 @@
 // and the checks those requests share; internal to the core.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <vector>
 
@@ -100,6 +101,44 @@ inline void setBodies(const SceneQueries& queries, const std::vector<std::size_t
     answer.bodies[i] = queries.body(indices[i]).name;
     answer.dofs[i] = static_cast<std::uint32_t>(queries.dofs(indices[i]));
   }
+}
+
+/// One slot of a batched multi-body answer: configuration k, listed body i.
+struct BodySlot
+{
+  std::size_t body;  ///< the body's index in the scene
+  std::size_t n;     ///< k n_bodies + i: the slot's index among the answer's slots
+  std::size_t v;     ///< k D + x_offset[i]: where its vectors (x, x', tau, ...) start
+  std::size_t m;     ///< k per_m + m_offset[i]: where its d x d matrices start
+  const double* x;   ///< its d coordinates: q + v, or the current state when q is empty
+};
+
+/// Calls visit(slot) for every configuration k < K and listed body i, in
+/// the answer's order (configuration-major), and sets cos_theta (K n
+/// values): cos(theta) of a free root (0 at gimbal lock), 1 for a fixed base.
+template <typename Visit>
+void forEachBodySlot(const SceneQueries& queries, const RequestLayout& layout, const std::vector<std::size_t>& indices,
+                     std::size_t K, const SceneState& current, const std::vector<double>& q,
+                     std::vector<double>& cos_theta, Visit&& visit)
+{
+  const std::size_t n = indices.size();
+  cos_theta.resize(K * n);
+  for (std::size_t k = 0; k < K; ++k)
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      const std::size_t v = k * layout.D + layout.x_offset[i];
+      const BodySlot slot{ indices[i], k * n + i, v, k * layout.per_m + layout.m_offset[i],
+                           q.empty() ? current[indices[i]].data() : q.data() + v };
+      visit(slot);
+      cos_theta[slot.n] = queries.body(slot.body).hasFreeRoot() ? std::cos(slot.x[THETA]) : 1.0;
+    }
+}
+
+/// Refuses an answer with a value that is not finite, naming its field.
+inline void requireFiniteResults(std::initializer_list<std::pair<const char*, const std::vector<double>*>> results)
+{
+  for (const auto& [field, values] : results)
+    requireFinite(values->data(), values->size(), field);
 }
 
 inline const double* slice(const std::vector<double>& values, std::size_t offset)

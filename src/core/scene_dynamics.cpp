@@ -14,7 +14,9 @@ namespace diff_rigid_body
 {
 using detail::checkDynamicsBudget;
 using detail::dynamicsConfigurations;
+using detail::forEachBodySlot;
 using detail::reject;
+using detail::requireFiniteResults;
 using detail::setBodies;
 using detail::sizeMismatch;
 using detail::slice;
@@ -73,33 +75,26 @@ void SceneQueries::inverseDynamics(const SceneState& current, const std::vector<
   answer.coriolis_matrices.resize(coriolis ? K * layout.per_m : 0);
   answer.dtau_dq.resize(derivatives ? K * layout.per_m : 0);
   answer.dtau_dqdot.resize(derivatives ? K * layout.per_m : 0);
-  answer.cos_theta.resize(K * n);
-  for (std::size_t k = 0; k < K; ++k)
-    for (std::size_t i = 0; i < n; ++i)
+  forEachBodySlot(*this, layout, indices, K, current, q, answer.cos_theta, [&](const detail::BodySlot& slot) {
+    BodyWorkspace<double>& ws = workspace(slot.body);
+    const std::size_t v = slot.v, m = slot.m;
+    inverseDynamicsTerms(scene_.bodies[slot.body], ws, slot.x, slice(qdot, v), slice(qddot, v), gravity_,
+                         answer.tau.data() + v, answer.velocity_terms.data() + v, answer.gravity_terms.data() + v,
+                         matrices > 0 ? &ws.derivative_x : nullptr, &ws.derivative_xd);
+    if (coriolis)
+      writeRowMajor(ws.derivative_xd, 0.5, answer.coriolis_matrices.data() + m);
+    if (derivatives)
     {
-      const BodyModel& body = scene_.bodies[indices[i]];
-      BodyWorkspace<double>& ws = workspace(indices[i]);
-      const std::size_t v = k * layout.D + layout.x_offset[i], m = k * layout.per_m + layout.m_offset[i];
-      const double* x = q.empty() ? current[indices[i]].data() : q.data() + v;
-      const double *xd = slice(qdot, v), *xdd = slice(qddot, v);
-      inverseDynamicsTerms(body, ws, x, xd, xdd, gravity_, answer.tau.data() + v, answer.velocity_terms.data() + v,
-                           answer.gravity_terms.data() + v, matrices > 0 ? &ws.derivative_x : nullptr,
-                           &ws.derivative_xd);
-      if (coriolis)
-        writeRowMajor(ws.derivative_xd, 0.5, answer.coriolis_matrices.data() + m);
-      if (derivatives)
-      {
-        writeRowMajor(ws.derivative_x, 1.0, answer.dtau_dq.data() + m);
-        writeRowMajor(ws.derivative_xd, 1.0, answer.dtau_dqdot.data() + m);
-      }
-      answer.cos_theta[k * n + i] = body.hasFreeRoot() ? std::cos(x[THETA]) : 1.0;
+      writeRowMajor(ws.derivative_x, 1.0, answer.dtau_dq.data() + m);
+      writeRowMajor(ws.derivative_xd, 1.0, answer.dtau_dqdot.data() + m);
     }
-  for (const auto& [field, values] :
-       { std::make_pair("result tau", &answer.tau), std::make_pair("result velocity_terms", &answer.velocity_terms),
-         std::make_pair("result gravity_terms", &answer.gravity_terms),
-         std::make_pair("result coriolis_matrices", &answer.coriolis_matrices),
-         std::make_pair("result dtau_dq", &answer.dtau_dq), std::make_pair("result dtau_dqdot", &answer.dtau_dqdot) })
-    requireFinite(values->data(), values->size(), field);
+  });
+  requireFiniteResults({ { "result tau", &answer.tau },
+                         { "result velocity_terms", &answer.velocity_terms },
+                         { "result gravity_terms", &answer.gravity_terms },
+                         { "result coriolis_matrices", &answer.coriolis_matrices },
+                         { "result dtau_dq", &answer.dtau_dq },
+                         { "result dtau_dqdot", &answer.dtau_dqdot } });
 }
 
 void SceneQueries::forwardDynamics(const SceneState& current, const std::vector<std::string>& names,
@@ -118,36 +113,31 @@ void SceneQueries::forwardDynamics(const SceneState& current, const std::vector<
   answer.dqddot_dq.resize(derivatives ? K * layout.per_m : 0);
   answer.dqddot_dqdot.resize(derivatives ? K * layout.per_m : 0);
   answer.dqddot_dtau.resize(derivatives ? K * layout.per_m : 0);
-  answer.cos_theta.resize(K * n);
-  for (std::size_t k = 0; k < K; ++k)
-    for (std::size_t i = 0; i < n; ++i)
+  forEachBodySlot(*this, layout, indices, K, current, q, answer.cos_theta, [&](const detail::BodySlot& slot) {
+    const BodyModel& body = scene_.bodies[slot.body];
+    BodyWorkspace<double>& ws = workspace(slot.body);
+    const double *xd = slice(qdot, slot.v), *generalized_force = slice(tau, slot.v);
+    double* xdd = answer.qddot.data() + slot.v;
+    const int singular = derivatives ? forwardDynamicsDerivatives(body, ws, slot.x, xd, generalized_force, gravity_,
+                                                                  xdd, ws.derivative_x, ws.derivative_xd,
+                                                                  ws.inverse_mass) :
+                                       diff_rigid_body::forwardDynamics(body, ws, slot.x, xd, generalized_force,
+                                                                        gravity_, xdd);
+    if (singular >= 0)
+      reject((K > 1 ? "q (configuration " + std::to_string(slot.n / n) + ")" : std::string("q")) + ": body '" +
+             body.name + "': M(x) is singular, so forward dynamics is undefined there: " +
+             singularReason(body, slot.x, singular));
+    if (derivatives)
     {
-      const BodyModel& body = scene_.bodies[indices[i]];
-      BodyWorkspace<double>& ws = workspace(indices[i]);
-      const std::size_t v = k * layout.D + layout.x_offset[i], m = k * layout.per_m + layout.m_offset[i];
-      const double* x = q.empty() ? current[indices[i]].data() : q.data() + v;
-      const double *xd = slice(qdot, v), *generalized_force = slice(tau, v);
-      double* xdd = answer.qddot.data() + v;
-      const int singular =
-          derivatives ? forwardDynamicsDerivatives(body, ws, x, xd, generalized_force, gravity_, xdd, ws.derivative_x,
-                                                   ws.derivative_xd, ws.inverse_mass) :
-                        diff_rigid_body::forwardDynamics(body, ws, x, xd, generalized_force, gravity_, xdd);
-      if (singular >= 0)
-        reject((K > 1 ? "q (configuration " + std::to_string(k) + ")" : std::string("q")) + ": body '" + body.name +
-               "': M(x) is singular, so forward dynamics is undefined there: " + singularReason(body, x, singular));
-      if (derivatives)
-      {
-        writeRowMajor(ws.derivative_x, 1.0, answer.dqddot_dq.data() + m);
-        writeRowMajor(ws.derivative_xd, 1.0, answer.dqddot_dqdot.data() + m);
-        writeRowMajor(ws.inverse_mass, 1.0, answer.dqddot_dtau.data() + m);
-      }
-      answer.cos_theta[k * n + i] = body.hasFreeRoot() ? std::cos(x[THETA]) : 1.0;
+      writeRowMajor(ws.derivative_x, 1.0, answer.dqddot_dq.data() + slot.m);
+      writeRowMajor(ws.derivative_xd, 1.0, answer.dqddot_dqdot.data() + slot.m);
+      writeRowMajor(ws.inverse_mass, 1.0, answer.dqddot_dtau.data() + slot.m);
     }
-  for (const auto& [field, values] :
-       { std::make_pair("result qddot", &answer.qddot), std::make_pair("result dqddot_dq", &answer.dqddot_dq),
-         std::make_pair("result dqddot_dqdot", &answer.dqddot_dqdot),
-         std::make_pair("result dqddot_dtau", &answer.dqddot_dtau) })
-    requireFinite(values->data(), values->size(), field);
+  });
+  requireFiniteResults({ { "result qddot", &answer.qddot },
+                         { "result dqddot_dq", &answer.dqddot_dq },
+                         { "result dqddot_dqdot", &answer.dqddot_dqdot },
+                         { "result dqddot_dtau", &answer.dqddot_dtau } });
 }
 
 }  // namespace diff_rigid_body

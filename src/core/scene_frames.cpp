@@ -15,7 +15,9 @@ namespace diff_rigid_body
 {
 using detail::checkDynamicsBudget;
 using detail::dynamicsConfigurations;
+using detail::forEachBodySlot;
 using detail::reject;
+using detail::requireFiniteResults;
 using detail::setBodies;
 using detail::slice;
 
@@ -167,9 +169,9 @@ void SceneQueries::frameJacobians(const SceneState& current, const std::string& 
     }
     answer.cos_theta[k] = body.hasFreeRoot() ? std::cos(x[THETA]) : 1.0;
   }
-  requireFinite(answer.poses.data(), answer.poses.size(), "result poses");
-  requireFinite(answer.jacobians.data(), answer.jacobians.size(), "result jacobians");
-  requireFinite(answer.acceleration_bias.data(), answer.acceleration_bias.size(), "result acceleration_bias");
+  requireFiniteResults({ { "result poses", &answer.poses },
+                         { "result jacobians", &answer.jacobians },
+                         { "result acceleration_bias", &answer.acceleration_bias } });
 }
 
 void SceneQueries::centerOfMass(const SceneState& current, const std::vector<std::string>& names,
@@ -191,21 +193,15 @@ void SceneQueries::centerOfMass(const SceneState& current, const std::vector<std
   answer.com.resize(K * n * 3);
   answer.jacobians.resize(jacobians ? K * 3 * layout.D : 0);
   answer.acceleration_bias.resize(jacobians ? K * n * 3 : 0);
-  answer.cos_theta.resize(K * n);
-  for (std::size_t k = 0; k < K; ++k)
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      const BodyModel& body = scene_.bodies[indices[i]];
-      const std::size_t v = k * layout.D + layout.x_offset[i], slot = k * n + i;
-      const double* x = q.empty() ? current[indices[i]].data() : q.data() + v;
-      answer.masses[i] = diff_rigid_body::centerOfMass(body, workspace(indices[i]), x, slice(qdot, v), answer.com.data() + 3 * slot,
-                                      jacobians ? answer.jacobians.data() + 3 * v : nullptr,
-                                      jacobians ? answer.acceleration_bias.data() + 3 * slot : nullptr);
-      answer.cos_theta[slot] = body.hasFreeRoot() ? std::cos(x[THETA]) : 1.0;
-    }
-  requireFinite(answer.com.data(), answer.com.size(), "result com");
-  requireFinite(answer.jacobians.data(), answer.jacobians.size(), "result jacobians");
-  requireFinite(answer.acceleration_bias.data(), answer.acceleration_bias.size(), "result acceleration_bias");
+  forEachBodySlot(*this, layout, indices, K, current, q, answer.cos_theta, [&](const detail::BodySlot& slot) {
+    answer.masses[slot.n % n] = diff_rigid_body::centerOfMass(
+        scene_.bodies[slot.body], workspace(slot.body), slot.x, slice(qdot, slot.v), answer.com.data() + 3 * slot.n,
+        jacobians ? answer.jacobians.data() + 3 * slot.v : nullptr,
+        jacobians ? answer.acceleration_bias.data() + 3 * slot.n : nullptr);
+  });
+  requireFiniteResults({ { "result com", &answer.com },
+                         { "result jacobians", &answer.jacobians },
+                         { "result acceleration_bias", &answer.acceleration_bias } });
 }
 
 }  // namespace diff_rigid_body

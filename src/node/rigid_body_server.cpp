@@ -15,6 +15,7 @@ namespace diff_rigid_body
 {
 using node::appendMatrix;
 using node::serve;
+using node::serveAnswer;
 using node::setTransform;
 
 namespace
@@ -246,13 +247,8 @@ bool RigidBodyServer::getState(GetState::Request& request, GetState::Response& r
 
 bool RigidBodyServer::getMassMatrix(GetMassMatrix::Request& request, GetMassMatrix::Response& response)
 {
-  return serve(response, "get_mass_matrix", [&] {
-    MassMatrixAnswer answer = queries_.massMatrices(*snapshot(), request.bodies, request.q, request.derivatives);
-    response.bodies = std::move(answer.bodies);
-    response.dofs = std::move(answer.dofs);
-    response.mass_matrices = std::move(answer.mass_matrices);
-    response.derivatives = std::move(answer.derivatives);
-    response.cos_theta = std::move(answer.cos_theta);
+  return serveAnswer<MassMatrixAnswer>(response, "get_mass_matrix", [&](MassMatrixAnswer& answer) {
+    queries_.massMatrices(*snapshot(), request.bodies, request.q, request.derivatives, answer);
   });
 }
 
@@ -324,65 +320,32 @@ bool RigidBodyServer::getVertexJacobiansCompact(GetVertexJacobiansCompact::Reque
 
 bool RigidBodyServer::inverseDynamics(InverseDynamics::Request& request, InverseDynamics::Response& response)
 {
-  return serve(response, "inverse_dynamics", [&] {
-    InverseDynamicsAnswer answer;
+  return serveAnswer<InverseDynamicsAnswer>(response, "inverse_dynamics", [&](InverseDynamicsAnswer& answer) {
     queries_.inverseDynamics(*snapshot(), request.bodies, request.q, request.qdot, request.qddot,
                              request.coriolis_matrices, request.derivatives, answer);
-    response.bodies = std::move(answer.bodies);
-    response.dofs = std::move(answer.dofs);
-    response.tau = std::move(answer.tau);
-    response.velocity_terms = std::move(answer.velocity_terms);
-    response.gravity_terms = std::move(answer.gravity_terms);
-    response.coriolis_matrices = std::move(answer.coriolis_matrices);
-    response.dtau_dq = std::move(answer.dtau_dq);
-    response.dtau_dqdot = std::move(answer.dtau_dqdot);
-    response.cos_theta = std::move(answer.cos_theta);
   });
 }
 
 bool RigidBodyServer::forwardDynamics(ForwardDynamics::Request& request, ForwardDynamics::Response& response)
 {
-  return serve(response, "forward_dynamics", [&] {
-    ForwardDynamicsAnswer answer;
+  return serveAnswer<ForwardDynamicsAnswer>(response, "forward_dynamics", [&](ForwardDynamicsAnswer& answer) {
     queries_.forwardDynamics(*snapshot(), request.bodies, request.q, request.qdot, request.tau, request.derivatives,
                              answer);
-    response.bodies = std::move(answer.bodies);
-    response.dofs = std::move(answer.dofs);
-    response.qddot = std::move(answer.qddot);
-    response.dqddot_dq = std::move(answer.dqddot_dq);
-    response.dqddot_dqdot = std::move(answer.dqddot_dqdot);
-    response.dqddot_dtau = std::move(answer.dqddot_dtau);
-    response.cos_theta = std::move(answer.cos_theta);
   });
 }
 
 bool RigidBodyServer::getFrameJacobians(GetFrameJacobians::Request& request, GetFrameJacobians::Response& response)
 {
-  return serve(response, "get_frame_jacobians", [&] {
-    FrameJacobianAnswer answer;
+  return serveAnswer<FrameJacobianAnswer>(response, "get_frame_jacobians", [&](FrameJacobianAnswer& answer) {
     queries_.frameJacobians(*snapshot(), request.body, request.frames, request.q, request.qdot, request.reference,
                             request.acceleration_bias, answer);
-    response.frames = std::move(answer.frames);
-    response.dofs = answer.dofs;
-    response.poses = std::move(answer.poses);
-    response.jacobians = std::move(answer.jacobians);
-    response.acceleration_bias = std::move(answer.acceleration_bias);
-    response.cos_theta = std::move(answer.cos_theta);
   });
 }
 
 bool RigidBodyServer::getCenterOfMass(GetCenterOfMass::Request& request, GetCenterOfMass::Response& response)
 {
-  return serve(response, "get_center_of_mass", [&] {
-    CenterOfMassAnswer answer;
+  return serveAnswer<CenterOfMassAnswer>(response, "get_center_of_mass", [&](CenterOfMassAnswer& answer) {
     queries_.centerOfMass(*snapshot(), request.bodies, request.q, request.qdot, request.jacobians, answer);
-    response.bodies = std::move(answer.bodies);
-    response.dofs = std::move(answer.dofs);
-    response.masses = std::move(answer.masses);
-    response.com = std::move(answer.com);
-    response.jacobians = std::move(answer.jacobians);
-    response.acceleration_bias = std::move(answer.acceleration_bias);
-    response.cos_theta = std::move(answer.cos_theta);
   });
 }
 

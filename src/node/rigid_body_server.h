@@ -98,20 +98,10 @@ private:
   void publishStaticLinks();
 
   // The service handlers, one per entry of DIFF_RIGID_BODY_SERVICES (diff_rigid_body_ros/services.h).
-  bool getBodies(GetBodies::Request& request, GetBodies::Response& response);
-  bool setState(SetState::Request& request, SetState::Response& response);
-  bool getState(GetState::Request& request, GetState::Response& response);
-  bool getMassMatrix(GetMassMatrix::Request& request, GetMassMatrix::Response& response);
-  bool getVertexJacobians(GetVertexJacobians::Request& request, GetVertexJacobians::Response& response);
-  bool backprop(Backprop::Request& request, Backprop::Response& response);
-  bool getVertexJacobiansCompact(GetVertexJacobiansCompact::Request& request,
-                                 GetVertexJacobiansCompact::Response& response);
-  bool inverseDynamics(InverseDynamics::Request& request, InverseDynamics::Response& response);
-  bool forwardDynamics(ForwardDynamics::Request& request, ForwardDynamics::Response& response);
-  bool getFrameJacobians(GetFrameJacobians::Request& request, GetFrameJacobians::Response& response);
-  bool getCenterOfMass(GetCenterOfMass::Request& request, GetCenterOfMass::Response& response);
-  bool ping(Ping::Request& request, Ping::Response& response);
-  bool echo(Echo::Request& request, Echo::Response& response);
+#define DRB_DECLARE_HANDLER(name, srv_type, handler, python_method, cpp_method, benchmark_only)                         \
+  bool handler(srv_type::Request& request, srv_type::Response& response);
+  DIFF_RIGID_BODY_SERVICES(DRB_DECLARE_HANDLER)
+#undef DRB_DECLARE_HANDLER
   void onSetStates(const BodyStateArray::ConstPtr& message);
   /// joint_states: named joints set, unknown names ignored (each logged
   /// once), a message with a non-finite position, a position count other

@@ -77,6 +77,19 @@ bool serve(Response& response, const char* service, Work&& work)
   return true;
 }
 
+/// serve() for a batched query: `query(answer)` fills a fresh Answer of
+/// scene_queries.h, which is then moved into the response field by field
+/// (Answer::moveInto, from the answer's one field list).
+template <typename Answer, typename Response, typename Query>
+bool serveAnswer(Response& response, const char* service, Query&& query)
+{
+  return serve(response, service, [&] {
+    Answer answer;
+    query(answer);
+    answer.moveInto(response);
+  });
+}
+
 /// Runs a topic or timer callback's `work`. Any exception is caught here, so
 /// that none reaches roscpp (which would end the node): it becomes the
 /// returned message (failureMessage, "" when `work` returned), which the
