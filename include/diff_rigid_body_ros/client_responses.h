@@ -3,6 +3,8 @@
 #pragma once
 
 #include <cstdint>
+#include <initializer_list>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -115,38 +117,49 @@ inline std::vector<Eigen::MatrixXd> perEntryMatrices(const std::vector<double>& 
   return out;
 }
 
-/// inverse_dynamics: one entry per body and configuration (cos_theta has one value per entry).
-inline InverseDynamicsResult toInverseDynamics(const diff_rigid_body::InverseDynamics::Response& r)
+/// A dynamics response split per entry (configuration k, body i; cos_theta
+/// has one value per entry): each (result member, response member) pair of
+/// `vectors` holds d_i values per entry, of `matrices` d_i x d_i row-major.
+template <typename Result, typename Response>
+Result perEntryResult(
+    const Response& r,
+    std::initializer_list<std::pair<std::vector<Eigen::VectorXd> Result::*, std::vector<double> Response::*>> vectors,
+    std::initializer_list<std::pair<std::vector<Eigen::MatrixXd> Result::*, std::vector<double> Response::*>> matrices)
 {
-  InverseDynamicsResult out;
+  Result out;
   out.bodies = r.bodies;
   out.dofs = r.dofs;
   const std::size_t entries = r.cos_theta.size();
   out.configurations = out.bodies.empty() ? 0 : entries / out.bodies.size();
-  out.tau = perEntryVectors(r.tau, r.dofs, entries);
-  out.velocity_terms = perEntryVectors(r.velocity_terms, r.dofs, entries);
-  out.gravity_terms = perEntryVectors(r.gravity_terms, r.dofs, entries);
-  out.coriolis_matrices = perEntryMatrices(r.coriolis_matrices, r.dofs, entries);
-  out.dtau_dq = perEntryMatrices(r.dtau_dq, r.dofs, entries);
-  out.dtau_dqdot = perEntryMatrices(r.dtau_dqdot, r.dofs, entries);
+  for (const auto& [to, from] : vectors)
+    out.*to = perEntryVectors(r.*from, r.dofs, entries);
+  for (const auto& [to, from] : matrices)
+    out.*to = perEntryMatrices(r.*from, r.dofs, entries);
   out.cos_theta = r.cos_theta;
   return out;
 }
 
-/// forward_dynamics, as toInverseDynamics.
+inline InverseDynamicsResult toInverseDynamics(const diff_rigid_body::InverseDynamics::Response& r)
+{
+  using Out = InverseDynamicsResult;
+  using In = diff_rigid_body::InverseDynamics::Response;
+  return perEntryResult<Out>(r,
+                             { { &Out::tau, &In::tau },
+                               { &Out::velocity_terms, &In::velocity_terms },
+                               { &Out::gravity_terms, &In::gravity_terms } },
+                             { { &Out::coriolis_matrices, &In::coriolis_matrices },
+                               { &Out::dtau_dq, &In::dtau_dq },
+                               { &Out::dtau_dqdot, &In::dtau_dqdot } });
+}
+
 inline ForwardDynamicsResult toForwardDynamics(const diff_rigid_body::ForwardDynamics::Response& r)
 {
-  ForwardDynamicsResult out;
-  out.bodies = r.bodies;
-  out.dofs = r.dofs;
-  const std::size_t entries = r.cos_theta.size();
-  out.configurations = out.bodies.empty() ? 0 : entries / out.bodies.size();
-  out.qddot = perEntryVectors(r.qddot, r.dofs, entries);
-  out.dqddot_dq = perEntryMatrices(r.dqddot_dq, r.dofs, entries);
-  out.dqddot_dqdot = perEntryMatrices(r.dqddot_dqdot, r.dofs, entries);
-  out.dqddot_dtau = perEntryMatrices(r.dqddot_dtau, r.dofs, entries);
-  out.cos_theta = r.cos_theta;
-  return out;
+  using Out = ForwardDynamicsResult;
+  using In = diff_rigid_body::ForwardDynamics::Response;
+  return perEntryResult<Out>(r, { { &Out::qddot, &In::qddot } },
+                             { { &Out::dqddot_dq, &In::dqddot_dq },
+                               { &Out::dqddot_dqdot, &In::dqddot_dqdot },
+                               { &Out::dqddot_dtau, &In::dqddot_dtau } });
 }
 
 /// get_vertex_jacobians of K configurations: one block of positions and J per configuration.
