@@ -141,41 +141,40 @@ def _vector_jacobian(grad, jacobian, needed):
     return torch.from_numpy(np.einsum('ka,kab->kb', _numpy(grad), jacobian)).to(grad.dtype)
 
 
-class _InverseDynamics(torch.autograd.Function):
+class _DynamicsFunction(torch.autograd.Function):
+    """y(a, b, c) of three (K, d) inputs and (client, body, per_frame); the
+    forward stores ctx.jacobians, dy/da, dy/db and dy/dc as (K, d, d) arrays
+    (None where not needed), and the backward is grad_y^T times each."""
+
+    @staticmethod
+    @once_differentiable
+    def backward(ctx, grad_y):
+        return tuple(_vector_jacobian(grad_y, jacobian, needs)
+                     for jacobian, needs in zip(ctx.jacobians, ctx.needs_input_grad[:3])) + (None, None, None)
+
+
+class _InverseDynamics(_DynamicsFunction):
+    """tau(q, qdot, qddot): dtau/dq, dtau/dqdot and M."""
 
     @staticmethod
     def forward(ctx, q, qdot, qddot, client, body, per_frame):
         needs_q, needs_qdot, needs_qddot = ctx.needs_input_grad[:3]
-        tau, ctx.dtau_dq, ctx.dtau_dqdot, ctx.M = inverse_dynamics_batch(
+        tau, dtau_dq, dtau_dqdot, M = inverse_dynamics_batch(
             client, body, _numpy(q), _numpy(qdot), _numpy(qddot), derivatives=needs_q or needs_qdot,
             mass_matrix=needs_qddot, per_frame=per_frame)
+        ctx.jacobians = (dtau_dq, dtau_dqdot, M)
         return torch.from_numpy(np.array(tau)).to(q.dtype)
 
-    @staticmethod
-    @once_differentiable
-    def backward(ctx, grad_tau):
-        needs_q, needs_qdot, needs_qddot = ctx.needs_input_grad[:3]
-        return (_vector_jacobian(grad_tau, ctx.dtau_dq, needs_q),
-                _vector_jacobian(grad_tau, ctx.dtau_dqdot, needs_qdot),
-                _vector_jacobian(grad_tau, ctx.M, needs_qddot), None, None, None)
 
-
-class _ForwardDynamics(torch.autograd.Function):
+class _ForwardDynamics(_DynamicsFunction):
+    """qddot(q, qdot, tau): dqddot/dq, dqddot/dqdot and M^-1."""
 
     @staticmethod
     def forward(ctx, q, qdot, tau, client, body, per_frame):
-        qddot, ctx.dqddot_dq, ctx.dqddot_dqdot, ctx.dqddot_dtau = forward_dynamics_batch(
+        qddot, *ctx.jacobians = forward_dynamics_batch(
             client, body, _numpy(q), _numpy(qdot), _numpy(tau), derivatives=any(ctx.needs_input_grad[:3]),
             per_frame=per_frame)
         return torch.from_numpy(np.array(qddot)).to(q.dtype)
-
-    @staticmethod
-    @once_differentiable
-    def backward(ctx, grad_qddot):
-        needs_q, needs_qdot, needs_tau = ctx.needs_input_grad[:3]
-        return (_vector_jacobian(grad_qddot, ctx.dqddot_dq, needs_q),
-                _vector_jacobian(grad_qddot, ctx.dqddot_dqdot, needs_qdot),
-                _vector_jacobian(grad_qddot, ctx.dqddot_dtau, needs_tau), None, None, None)
 
 
 def _batched(q, client, body):
