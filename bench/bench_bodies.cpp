@@ -25,10 +25,10 @@
 // Items: 1 per configuration, n per vertex row.
 #include <random>
 
-#include "diff_rigid_body/crba.h"
-#include "diff_rigid_body/mass_matrix_derivatives.h"
-#include "diff_rigid_body/vertex_backprop.h"
-#include "diff_rigid_body/vertex_jacobians.h"
+#include "diff_rigid_body/algorithm/crba.h"
+#include "diff_rigid_body/algorithm/mass_matrix_derivatives.h"
+#include "diff_rigid_body/algorithm/vertex_backprop.h"
+#include "diff_rigid_body/algorithm/vertex_jacobians.h"
 #include "memory_floors.h"
 #include "robot_peers.h"
 #include "robot_timing.h"

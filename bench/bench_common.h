@@ -18,9 +18,9 @@
 
 #include <Eigen/Core>
 
-#include "diff_rigid_body/triangle_mesh.h"
-#include "diff_rigid_body/free_body/vertex_columns.h"
-#include "diff_rigid_body/free_body/vertex_jacobian.h"
+#include "diff_rigid_body/mass/triangle_mesh.h"
+#include "diff_rigid_body/algorithm/free_body/vertex_columns.h"
+#include "diff_rigid_body/algorithm/free_body/vertex_jacobian.h"
 #include "../test/support/meshes.h"  // readObj, shared with the tests
 
 namespace drb_bench

@@ -17,9 +17,9 @@
 //       computeABADerivatives
 // Pinocchio's floating humanoid is its own FreeFlyer model (pinocchio_coordinates.h).
 // Items: 1 per state.
-#include "diff_rigid_body/forward_dynamics.h"
-#include "diff_rigid_body/rnea.h"
-#include "diff_rigid_body/rnea_derivatives.h"
+#include "diff_rigid_body/algorithm/forward_dynamics.h"
+#include "diff_rigid_body/algorithm/rnea.h"
+#include "diff_rigid_body/algorithm/rnea_derivatives.h"
 #include "robot_peers.h"
 #include "robot_timing.h"
 

@@ -16,8 +16,8 @@
 //       pinocchio   jacobianCenterOfMass
 //       mujoco      mj_kinematics + mj_comPos + mj_jacSubtreeCom of the body's root
 // Items: 1 per configuration.
-#include "diff_rigid_body/frame_jacobians.h"
-#include "diff_rigid_body/kinematics.h"
+#include "diff_rigid_body/algorithm/frame_jacobians.h"
+#include "diff_rigid_body/algorithm/kinematics.h"
 #include "robot_peers.h"
 #include "robot_timing.h"
 

@@ -15,7 +15,7 @@
 #include <map>
 #include <string>
 
-#include "diff_rigid_body/forward_dynamics.h"
+#include "diff_rigid_body/algorithm/forward_dynamics.h"
 #include "../test/support/dynamics_fixtures.h"
 #include "../test/support/gimbal_reference.h"
 

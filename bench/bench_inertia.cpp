@@ -13,7 +13,7 @@
 #include <cstdlib>
 
 #include "bench_common.h"
-#include "diff_rigid_body/mass_properties.h"
+#include "diff_rigid_body/mass/mass_properties.h"
 #include "reference/particle_mass_properties.h"
 
 namespace

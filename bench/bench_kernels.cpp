@@ -19,8 +19,8 @@
 #include <random>
 
 #include "bench_common.h"
-#include "diff_rigid_body/scene_queries.h"
-#include "diff_rigid_body/urdf_scene.h"
+#include "diff_rigid_body/services/scene_queries.h"
+#include "diff_rigid_body/parsers/urdf_scene.h"
 #include "methods.h"
 #include "vertex_benchmarks.h"
 

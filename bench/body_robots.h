@@ -32,9 +32,9 @@
 
 #include <Eigen/Core>
 
-#include "diff_rigid_body/body_workspace.h"
-#include "diff_rigid_body/scene_queries.h"
-#include "diff_rigid_body/urdf_scene.h"
+#include "diff_rigid_body/multibody/body_workspace.h"
+#include "diff_rigid_body/services/scene_queries.h"
+#include "diff_rigid_body/parsers/urdf_scene.h"
 
 namespace drb_bench
 {

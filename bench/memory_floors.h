@@ -20,7 +20,7 @@
 #include <cstdint>
 
 #include "bench_common.h"
-#include "diff_rigid_body/free_body/vertex_columns.h"
+#include "diff_rigid_body/algorithm/free_body/vertex_columns.h"
 
 #if defined(DRB_VERTEX_KERNELS_AVX2)
 #include <immintrin.h>

@@ -20,8 +20,8 @@
 #include <string>
 
 #include "bench_common.h"
-#include "diff_rigid_body/free_body/mass_matrix.h"
-#include "diff_rigid_body/free_body/vertex_jacobian.h"
+#include "diff_rigid_body/algorithm/free_body/mass_matrix.h"
+#include "diff_rigid_body/algorithm/free_body/vertex_jacobian.h"
 #include "reference/vertex_kernels.h"
 
 #ifdef DRB_BENCH_HAVE_KDL

@@ -10,11 +10,11 @@
 #include <vector>
 
 #include "body_robots.h"
-#include "diff_rigid_body/crba.h"
-#include "diff_rigid_body/forward_dynamics.h"
-#include "diff_rigid_body/mass_matrix_derivatives.h"
-#include "diff_rigid_body/rnea.h"
-#include "diff_rigid_body/rnea_derivatives.h"
+#include "diff_rigid_body/algorithm/crba.h"
+#include "diff_rigid_body/algorithm/forward_dynamics.h"
+#include "diff_rigid_body/algorithm/mass_matrix_derivatives.h"
+#include "diff_rigid_body/algorithm/rnea.h"
+#include "diff_rigid_body/algorithm/rnea_derivatives.h"
 
 namespace drb_bench
 {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "diff_rigid_body/scene_queries.h"
+#include "diff_rigid_body/services/scene_queries.h"
 
 namespace diff_rigid_body
 {

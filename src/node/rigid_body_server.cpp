@@ -9,7 +9,7 @@
 #include <tf2_msgs/TFMessage.h>
 
 #include "diff_rigid_body/exceptions.h"
-#include "diff_rigid_body/state_file.h"
+#include "diff_rigid_body/state/state_file.h"
 
 namespace diff_rigid_body
 {

@@ -44,7 +44,7 @@
 #include <geometry_msgs/TransformStamped.h>
 #include <sensor_msgs/JointState.h>
 
-#include "diff_rigid_body/scene_queries.h"
+#include "diff_rigid_body/services/scene_queries.h"
 #include "diff_rigid_body_ros/services.h"
 #include "joint_limit_warnings.h"
 

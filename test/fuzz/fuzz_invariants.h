@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "diff_rigid_body/scene_queries.h"
+#include "diff_rigid_body/services/scene_queries.h"
 
 namespace drb_fuzz
 {

@@ -20,7 +20,7 @@
 #include <string>
 
 #include "diff_rigid_body/exceptions.h"
-#include "diff_rigid_body/mesh_loader.h"
+#include "diff_rigid_body/mass/mesh_loader.h"
 #include "fuzz_invariants.h"
 
 namespace

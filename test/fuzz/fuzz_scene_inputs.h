@@ -14,8 +14,8 @@
 
 #include <fuzzer/FuzzedDataProvider.h>
 
-#include "diff_rigid_body/scene_queries.h"
-#include "diff_rigid_body/urdf_scene.h"
+#include "diff_rigid_body/services/scene_queries.h"
+#include "diff_rigid_body/parsers/urdf_scene.h"
 
 namespace drb_fuzz
 {

@@ -7,8 +7,8 @@
 #include <cstring>
 #include <string>
 
-#include "diff_rigid_body/state_file.h"
-#include "diff_rigid_body/urdf_scene.h"
+#include "diff_rigid_body/state/state_file.h"
+#include "diff_rigid_body/parsers/urdf_scene.h"
 #include "fuzz_invariants.h"
 
 namespace

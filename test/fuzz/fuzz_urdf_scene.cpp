@@ -24,8 +24,8 @@
 #include <tinyxml2.h>
 
 #include "diff_rigid_body/exceptions.h"
-#include "diff_rigid_body/scene_queries.h"
-#include "diff_rigid_body/urdf_scene.h"
+#include "diff_rigid_body/services/scene_queries.h"
+#include "diff_rigid_body/parsers/urdf_scene.h"
 #include "fuzz_invariants.h"
 
 namespace

@@ -20,7 +20,7 @@
 #include <gtest/gtest.h>
 #include <ros/package.h>
 
-#include "diff_rigid_body/urdf_scene.h"
+#include "diff_rigid_body/parsers/urdf_scene.h"
 #include "server_under_test.h"
 
 namespace drb_rostest

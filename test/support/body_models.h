@@ -1,4 +1,4 @@
-// The core's body model (include/diff_rigid_body/body_model.h) from the
+// The core's body model (include/diff_rigid_body/multibody/body_model.h) from the
 // tests' side: models built by hand (the fields the URDF loader derives,
 // derived as the loader does: its dofs by its own buildDofs), and the
 // algorithms called with a workspace of their own, returning values.
@@ -14,13 +14,13 @@
 
 #include <Eigen/Core>
 
-#include "diff_rigid_body/body_model.h"
-#include "diff_rigid_body/crba.h"
-#include "diff_rigid_body/kinematics.h"
-#include "diff_rigid_body/mass_matrix_derivatives.h"
-#include "diff_rigid_body/vertex_backprop.h"
-#include "diff_rigid_body/vertex_jacobians.h"
-#include "../../src/core/body_coordinates.h"  // buildDofs: the loader's dofs of a hand-made model
+#include "diff_rigid_body/multibody/body_model.h"
+#include "diff_rigid_body/algorithm/crba.h"
+#include "diff_rigid_body/algorithm/kinematics.h"
+#include "diff_rigid_body/algorithm/mass_matrix_derivatives.h"
+#include "diff_rigid_body/algorithm/vertex_backprop.h"
+#include "diff_rigid_body/algorithm/vertex_jacobians.h"
+#include "../../src/core/parsers/body_coordinates.h"  // buildDofs: the loader's dofs of a hand-made model
 
 namespace drb_test
 {
@@ -35,7 +35,7 @@ using RowMajorMatrixXd = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, E
 // ---------------------------------------------------------------------------
 // Hand-made models.
 
-/// How a joint segment's value follows x (src/core/body_coordinates.h): multiplier x[coordinate] + offset.
+/// How a joint segment's value follows x (src/core/parsers/body_coordinates.h): multiplier x[coordinate] + offset.
 using JointCoordinate = drb::detail::JointCoordinate;
 
 /// Derives what follows from a model's primary fields (segments' link,

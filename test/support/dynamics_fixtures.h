@@ -10,7 +10,7 @@
 
 #include <Eigen/Core>
 
-#include "diff_rigid_body/urdf_scene.h"
+#include "diff_rigid_body/parsers/urdf_scene.h"
 #include "articulated_fixtures.h"
 #include "urdf_builders.h"
 

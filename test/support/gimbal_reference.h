@@ -21,8 +21,8 @@
 #include <mpreal.h>
 #include <unsupported/Eigen/MPRealSupport>
 
-#include "diff_rigid_body/crba.h"
-#include "diff_rigid_body/rnea.h"
+#include "diff_rigid_body/algorithm/crba.h"
+#include "diff_rigid_body/algorithm/rnea.h"
 
 namespace drb_test
 {

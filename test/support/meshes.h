@@ -12,7 +12,7 @@
 
 #include <Eigen/Core>
 
-#include "diff_rigid_body/triangle_mesh.h"
+#include "diff_rigid_body/mass/triangle_mesh.h"
 
 namespace drb_test
 {

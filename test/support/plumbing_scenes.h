@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "diff_rigid_body/body_model.h"
-#include "diff_rigid_body/urdf_scene.h"
+#include "diff_rigid_body/multibody/body_model.h"
+#include "diff_rigid_body/parsers/urdf_scene.h"
 #include "body_models.h"
 #include "urdf_builders.h"
 

@@ -14,7 +14,7 @@
 
 #include <gtest/gtest.h>
 
-#include "diff_rigid_body/state_file.h"
+#include "diff_rigid_body/state/state_file.h"
 
 namespace drb_test
 {

@@ -25,7 +25,7 @@
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
-#include "diff_rigid_body/free_body/mass_matrix.h"
+#include "diff_rigid_body/algorithm/free_body/mass_matrix.h"
 #include "../support/articulated_fixtures.h"
 #include "../support/body_models.h"
 

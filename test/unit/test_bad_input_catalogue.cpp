@@ -29,11 +29,11 @@
 #include <gtest/gtest.h>
 
 #include "diff_rigid_body/exceptions.h"
-#include "diff_rigid_body/mesh_loader.h"
-#include "diff_rigid_body/mass_property_checks.h"
-#include "diff_rigid_body/scene_queries.h"
-#include "diff_rigid_body/state_file.h"
-#include "diff_rigid_body/urdf_scene.h"
+#include "diff_rigid_body/mass/mesh_loader.h"
+#include "diff_rigid_body/mass/mass_property_checks.h"
+#include "diff_rigid_body/services/scene_queries.h"
+#include "diff_rigid_body/state/state_file.h"
+#include "diff_rigid_body/parsers/urdf_scene.h"
 #include "../support/catalogue_row.h"
 #include "../support/plumbing_scenes.h"
 #include "../support/state_files.h"

@@ -12,8 +12,8 @@
 #include <gtest/gtest.h>
 
 #include "diff_rigid_body/exceptions.h"
-#include "diff_rigid_body/free_body/vertex_jacobian.h"  // kStreamingStoreBytes
-#include "diff_rigid_body/scene_queries.h"
+#include "diff_rigid_body/algorithm/free_body/vertex_jacobian.h"  // kStreamingStoreBytes
+#include "diff_rigid_body/services/scene_queries.h"
 #include "../support/body_models.h"
 #include "../support/expect_throws.h"
 #include "../support/plumbing_scenes.h"

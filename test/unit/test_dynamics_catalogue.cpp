@@ -11,7 +11,7 @@
 
 #include <gtest/gtest.h>
 
-#include "diff_rigid_body/scene_queries.h"
+#include "diff_rigid_body/services/scene_queries.h"
 #include "../support/catalogue_row.h"
 #include "../support/plumbing_scenes.h"
 #include "../support/urdf_builders.h"

@@ -18,8 +18,8 @@
 #include <mpreal.h>
 #include <unsupported/Eigen/MPRealSupport>
 
-#include "diff_rigid_body/forward_dynamics.h"
-#include "diff_rigid_body/mass_matrix_derivatives.h"
+#include "diff_rigid_body/algorithm/forward_dynamics.h"
+#include "diff_rigid_body/algorithm/mass_matrix_derivatives.h"
 #include "../support/dynamics_fixtures.h"
 
 namespace drb = diff_rigid_body;

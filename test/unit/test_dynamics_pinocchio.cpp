@@ -15,8 +15,8 @@
 
 #include <gtest/gtest.h>
 
-#include "diff_rigid_body/forward_dynamics.h"
-#include "diff_rigid_body/scene_queries.h"
+#include "diff_rigid_body/algorithm/forward_dynamics.h"
+#include "diff_rigid_body/services/scene_queries.h"
 #include "pinocchio_peer.h"
 #include "../support/dynamics_fixtures.h"
 

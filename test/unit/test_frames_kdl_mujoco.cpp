@@ -21,7 +21,7 @@
 #include <kdl_parser/kdl_parser.hpp>
 #include <urdf_parser/urdf_parser.h>
 
-#include "diff_rigid_body/scene_queries.h"
+#include "diff_rigid_body/services/scene_queries.h"
 #include "../support/dynamics_fixtures.h"
 #include "../support/peer_joints.h"
 #include "../support/mujoco_model.h"

@@ -20,8 +20,8 @@
 #include <Eigen/SVD>
 #include <gtest/gtest.h>
 
-#include "diff_rigid_body/free_body/mass_matrix.h"
-#include "diff_rigid_body/free_body/vertex_jacobian.h"
+#include "diff_rigid_body/algorithm/free_body/mass_matrix.h"
+#include "diff_rigid_body/algorithm/free_body/vertex_jacobian.h"
 #include "reference/gimbal_lock.h"
 #include "reference/rpy_derivatives.h"
 #include "reference/vertex_kernels.h"

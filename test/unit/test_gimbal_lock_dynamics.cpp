@@ -13,8 +13,8 @@
 #include <gtest/gtest.h>
 
 #include "diff_rigid_body/exceptions.h"
-#include "diff_rigid_body/forward_dynamics.h"
-#include "diff_rigid_body/scene_queries.h"
+#include "diff_rigid_body/algorithm/forward_dynamics.h"
+#include "diff_rigid_body/services/scene_queries.h"
 #include "../support/dynamics_fixtures.h"
 #include "../support/expect_throws.h"
 #include "../support/gimbal_reference.h"

@@ -2,7 +2,7 @@
 // refused with a MeshLoadError naming the file, and the process that asked
 // survives. The assimp inputs in test/meshes/hostile were found by the
 // mesh_file fuzz target; they crash, or allocate without bound in, assimp
-// 5.2's Collada importer, which runs in a child process (src/core/child_process.h).
+// 5.2's Collada importer, which runs in a child process (src/core/mass/child_process.h).
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -12,8 +12,8 @@
 #include <gtest/gtest.h>
 
 #include "diff_rigid_body/exceptions.h"
-#include "diff_rigid_body/mesh_loader.h"
-#include "diff_rigid_body/urdf_scene.h"
+#include "diff_rigid_body/mass/mesh_loader.h"
+#include "diff_rigid_body/parsers/urdf_scene.h"
 #include "../support/expect_throws.h"
 #include "../support/state_files.h"
 #include "../support/urdf_builders.h"

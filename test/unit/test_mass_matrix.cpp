@@ -25,8 +25,8 @@
 
 #include <gtest/gtest.h>
 
-#include "diff_rigid_body/free_body/mass_matrix.h"
-#include "diff_rigid_body/free_body/vertex_jacobian.h"
+#include "diff_rigid_body/algorithm/free_body/mass_matrix.h"
+#include "diff_rigid_body/algorithm/free_body/vertex_jacobian.h"
 #include "reference/vertex_kernels.h"
 #include "../support/oracles.h"
 

@@ -26,7 +26,7 @@
 #include <gtest/gtest.h>
 
 #include "diff_rigid_body/exceptions.h"
-#include "diff_rigid_body/mass_properties.h"
+#include "diff_rigid_body/mass/mass_properties.h"
 #include "reference/particle_mass_properties.h"
 #include "../support/expect_throws.h"
 #include "../support/meshes.h"

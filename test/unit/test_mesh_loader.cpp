@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "diff_rigid_body/exceptions.h"
-#include "diff_rigid_body/mesh_loader.h"
+#include "diff_rigid_body/mass/mesh_loader.h"
 #include "../support/expect_throws.h"
 
 namespace drb = diff_rigid_body;

@@ -10,9 +10,9 @@
 #include <gtest/gtest.h>
 
 #include "diff_rigid_body/exceptions.h"
-#include "diff_rigid_body/mesh_loader.h"
-#include "diff_rigid_body/scene_queries.h"
-#include "diff_rigid_body/urdf_scene.h"
+#include "diff_rigid_body/mass/mesh_loader.h"
+#include "diff_rigid_body/services/scene_queries.h"
+#include "diff_rigid_body/parsers/urdf_scene.h"
 #include "../support/expect_throws.h"
 #include "../support/urdf_builders.h"
 

@@ -19,7 +19,7 @@
 #include <gtest/gtest.h>
 #include <tf2/LinearMath/Matrix3x3.h>
 
-#include "diff_rigid_body/rpy.h"
+#include "diff_rigid_body/multibody/rpy.h"
 #include "reference/rpy_derivatives.h"
 #include "../support/oracles.h"
 

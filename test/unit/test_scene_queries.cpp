@@ -11,7 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "diff_rigid_body/exceptions.h"
-#include "diff_rigid_body/scene_queries.h"
+#include "diff_rigid_body/services/scene_queries.h"
 #include "../support/body_models.h"
 #include "../support/expect_throws.h"
 #include "../support/kinematics_oracles.h"

@@ -14,8 +14,8 @@
 
 #include <gtest/gtest.h>
 
-#include "diff_rigid_body/state_file.h"
-#include "diff_rigid_body/urdf_scene.h"
+#include "diff_rigid_body/state/state_file.h"
+#include "diff_rigid_body/parsers/urdf_scene.h"
 #include "../support/expect_throws.h"
 #include "../support/plumbing_scenes.h"
 #include "../support/state_files.h"

@@ -35,8 +35,8 @@
 
 #include <gtest/gtest.h>
 
-#include "diff_rigid_body/scene_queries.h"
-#include "diff_rigid_body/urdf_scene.h"
+#include "diff_rigid_body/services/scene_queries.h"
+#include "diff_rigid_body/parsers/urdf_scene.h"
 #include "../support/articulated_fixtures.h"
 #include "../support/stored_answers.h"
 

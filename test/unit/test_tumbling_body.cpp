@@ -12,9 +12,9 @@
 
 #include <gtest/gtest.h>
 
-#include "diff_rigid_body/free_body/mass_matrix.h"
-#include "diff_rigid_body/rpy.h"
-#include "diff_rigid_body/scene_queries.h"
+#include "diff_rigid_body/algorithm/free_body/mass_matrix.h"
+#include "diff_rigid_body/multibody/rpy.h"
+#include "diff_rigid_body/services/scene_queries.h"
 #include "../support/urdf_builders.h"
 
 namespace drb = diff_rigid_body;

@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "diff_rigid_body/exceptions.h"
-#include "diff_rigid_body/urdf_scene.h"
+#include "diff_rigid_body/parsers/urdf_scene.h"
 #include "../support/expect_throws.h"
 #include "../support/urdf_builders.h"
 

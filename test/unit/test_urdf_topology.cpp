@@ -1,4 +1,4 @@
-// The joint graph check (src/core/urdf_topology.h) on hand-made graphs, and
+// The joint graph check (src/core/parsers/urdf_topology.h) on hand-made graphs, and
 // loadSceneFromUrdf on the descriptions that aborted or hung the node before
 // it (issue 22): each is refused by name, nothing throws anything else, and
 // nothing loops.
@@ -8,8 +8,8 @@
 #include <gtest/gtest.h>
 
 #include "diff_rigid_body/exceptions.h"
-#include "diff_rigid_body/urdf_scene.h"
-#include "../../src/core/urdf_topology.h"
+#include "diff_rigid_body/parsers/urdf_scene.h"
+#include "../../src/core/parsers/urdf_topology.h"
 #include "../support/expect_throws.h"
 
 namespace drb = diff_rigid_body;

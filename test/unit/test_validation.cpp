@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "diff_rigid_body/exceptions.h"
-#include "diff_rigid_body/mass_property_checks.h"
+#include "diff_rigid_body/mass/mass_property_checks.h"
 #include "../support/expect_throws.h"
 
 using diff_rigid_body::InvalidInertiaError;

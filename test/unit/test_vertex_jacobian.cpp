@@ -26,8 +26,8 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
-#include "diff_rigid_body/free_body/vertex_columns.h"
-#include "diff_rigid_body/free_body/vertex_jacobian.h"
+#include "diff_rigid_body/algorithm/free_body/vertex_columns.h"
+#include "diff_rigid_body/algorithm/free_body/vertex_jacobian.h"
 #include "reference/vertex_kernels.h"
 #include "../support/oracles.h"
 

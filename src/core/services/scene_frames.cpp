@@ -1,0 +1,207 @@
+// SceneQueries::frameJacobians and centerOfMass: the requests' checks and
+// layout, and frame_jacobians.h per configuration.
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <unordered_map>
+
+#include "diff_rigid_body/algorithm/frame_jacobians.h"
+#include "diff_rigid_body/algorithm/kinematics.h"
+#include "diff_rigid_body/services/scene_queries.h"
+#include "services/request_checks.h"
+#include "services/request_layout.h"
+
+namespace diff_rigid_body
+{
+using detail::checkDynamicsBudget;
+using detail::dynamicsConfigurations;
+using detail::forEachBodySlot;
+using detail::reject;
+using detail::requireFiniteResults;
+using detail::setBodies;
+using detail::slice;
+
+namespace
+{
+/// A listed frame: a link of the body (model.links index), or a static link
+/// (scene.static_links index, `fixed`; kFixedFrame for the fixed frame itself).
+struct FrameSlot
+{
+  std::size_t index = 0;
+  bool fixed = false;
+};
+constexpr std::size_t kFixedFrame = static_cast<std::size_t>(-1);
+
+/// "a, b, c" of at most 20 names, then how many there are.
+template <typename Names>
+std::string listed(const Names& names)
+{
+  constexpr std::size_t kListed = 20;
+  std::string out;
+  for (std::size_t i = 0; i < std::min(kListed, names.size()); ++i)
+    out += (i ? ", " : "") + names[i].name;
+  if (names.size() > kListed)
+    out += ", ... (" + std::to_string(names.size()) + ")";
+  return out;
+}
+
+/// The slots of `frames` (empty = every link of the body `body_index`), or a
+/// refusal naming the unknown frame and the body's links; `links` maps a
+/// link name to (body, link index).
+void frameSlots(const Scene& scene, std::size_t body_index, const std::vector<std::string>& frames,
+                const std::unordered_map<std::string, std::pair<std::size_t, std::size_t>>& links,
+                std::vector<FrameSlot>& slots)
+{
+  const BodyModel& body = scene.bodies[body_index];
+  slots.clear();
+  if (frames.empty())
+  {
+    for (std::size_t l = 0; l < body.links.size(); ++l)
+      slots.push_back({ l, false });
+    return;
+  }
+  if (frames.size() > RequestLimits::kMaxStates)
+    reject(detail::sizeMismatch("frames", "at most " + std::to_string(RequestLimits::kMaxStates) + " names",
+                                frames.size()));
+  for (std::size_t f = 0; f < frames.size(); ++f)
+  {
+    const auto link = links.find(frames[f]);
+    if (link != links.end() && link->second.first == body_index)
+    {
+      slots.push_back({ link->second.second, false });
+      continue;
+    }
+    if (frames[f] == scene.fixed_frame)
+    {
+      slots.push_back({ kFixedFrame, true });
+      continue;
+    }
+    const auto fixed = std::find_if(scene.static_links.begin(), scene.static_links.end(),
+                                    [&](const StaticLink& s) { return s.name == frames[f]; });
+    if (fixed != scene.static_links.end())
+    {
+      slots.push_back({ static_cast<std::size_t>(fixed - scene.static_links.begin()), true });
+      continue;
+    }
+    const std::string name = frames[f].size() > 64 ? frames[f].substr(0, 64) + "..." : frames[f];
+    const std::string elsewhere =
+        link == links.end() ? "" : " (it is a link of body '" + scene.bodies[link->second.first].name + "')";
+    reject("frames[" + std::to_string(f) + "]: unknown frame '" + name + "': not a link of body '" + body.name +
+           "' (its links: " + listed(body.links) + "), a static link" +
+           (scene.static_links.empty() ? "" : " (" + listed(scene.static_links) + ")") + " or the fixed frame '" +
+           scene.fixed_frame + "'" + elsewhere);
+  }
+}
+
+FrameReference frameReference(std::uint32_t reference)
+{
+  if (reference > 2)
+    reject("reference: " + std::to_string(reference) +
+           " is not one of 0 (WORLD), 1 (LOCAL), 2 (LOCAL_WORLD_ALIGNED)");
+  return static_cast<FrameReference>(reference);
+}
+
+/// A static frame's slot: its fixed pose, zero Jacobian and bias.
+void writeStaticFrame(const Eigen::Isometry3d& pose, std::size_t d, double* pose12, double* jacobian, double* bias)
+{
+  const Eigen::Vector3d p = pose.translation();
+  const Eigen::Matrix3d R = pose.linear();
+  for (int i = 0; i < 3; ++i)
+    pose12[i] = p[i];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      pose12[3 + 3 * r + c] = R(r, c);
+  std::fill(jacobian, jacobian + 6 * d, 0.0);
+  if (bias)
+    std::fill(bias, bias + 6, 0.0);
+}
+}  // namespace
+
+void SceneQueries::frameJacobians(const SceneState& current, const std::string& body_name,
+                                  const std::vector<std::string>& frames, const std::vector<double>& q,
+                                  const std::vector<double>& qdot, std::uint32_t reference, bool acceleration_bias,
+                                  FrameJacobianAnswer& answer) const
+{
+  const std::size_t index = bodyIndex(body_name, "body");
+  const BodyModel& body = scene_.bodies[index];
+  thread_local std::vector<FrameSlot> slots;
+  frameSlots(scene_, index, frames, link_index_, slots);
+  const FrameReference ref = frameReference(reference);
+  thread_local std::vector<std::size_t> indices;
+  indices.assign(1, index);
+  const detail::RequestLayout& layout = detail::requestLayout(*this, indices);
+  const std::size_t K = dynamicsConfigurations(layout, 1, q, { { "qdot", &qdot } });
+  const std::size_t d = body.coordinates, F = slots.size();
+  checkDynamicsBudget(K, F * (12 + 6 * d + (acceleration_bias ? 6 : 0)) + 1, true);
+  answer.frames.resize(F);
+  for (std::size_t f = 0; f < F; ++f)
+    answer.frames[f] = !slots[f].fixed                 ? body.links[slots[f].index].name
+                       : slots[f].index == kFixedFrame ? scene_.fixed_frame
+                                                       : scene_.static_links[slots[f].index].name;
+  answer.dofs = static_cast<std::uint32_t>(d);
+  answer.poses.resize(K * F * 12);
+  answer.jacobians.resize(K * F * 6 * d);
+  answer.acceleration_bias.resize(acceleration_bias ? K * F * 6 : 0);
+  answer.cos_theta.resize(K);
+  BodyWorkspace<double>& ws = workspace(index);
+  thread_local std::vector<char> needed;  // without the bias: only the listed frames' paths
+  needed.assign(body.segments.size(), acceleration_bias ? 1 : 0);
+  for (const FrameSlot& slot : slots)
+    if (!slot.fixed)
+      markSupport(body, slot.index, needed);
+  for (std::size_t k = 0; k < K; ++k)
+  {
+    const double* x = q.empty() ? current[index].data() : q.data() + k * d;
+    forwardKinematicsOf(body, ws, x, needed);
+    if (acceleration_bias)
+      frameMotion(body, ws, slice(qdot, k * d));
+    for (std::size_t f = 0; f < F; ++f)
+    {
+      const std::size_t n = k * F + f;
+      double* bias = acceleration_bias ? answer.acceleration_bias.data() + 6 * n : nullptr;
+      if (slots[f].fixed)
+        writeStaticFrame(slots[f].index == kFixedFrame ? Eigen::Isometry3d::Identity()
+                                                       : scene_.static_links[slots[f].index].pose_in_fixed_frame,
+                         d, answer.poses.data() + 12 * n, answer.jacobians.data() + 6 * d * n, bias);
+      else
+        frameJacobian(body, ws, slots[f].index, ref, answer.poses.data() + 12 * n,
+                      answer.jacobians.data() + 6 * d * n, bias);
+    }
+    answer.cos_theta[k] = body.hasFreeRoot() ? std::cos(x[THETA]) : 1.0;
+  }
+  requireFiniteResults({ { "result poses", &answer.poses },
+                         { "result jacobians", &answer.jacobians },
+                         { "result acceleration_bias", &answer.acceleration_bias } });
+}
+
+void SceneQueries::centerOfMass(const SceneState& current, const std::vector<std::string>& names,
+                                const std::vector<double>& q, const std::vector<double>& qdot, bool jacobians,
+                                CenterOfMassAnswer& answer) const
+{
+  thread_local std::vector<std::size_t> indices;
+  bodyIndices(names, "bodies", indices);
+  const detail::RequestLayout& layout = detail::requestLayout(*this, indices);
+  const std::size_t n = indices.size();
+  const std::size_t K = dynamicsConfigurations(layout, n, q, { { "qdot", &qdot } });
+  checkDynamicsBudget(K, 4 * n + (jacobians ? 3 * layout.D + 3 * n : 0), jacobians);
+  for (std::size_t i = 0; i < n; ++i)
+    if (!(scene_.bodies[indices[i]].mass() > 0.0))
+      reject("bodies[" + std::to_string(i) + "]: body '" + scene_.bodies[indices[i]].name +
+             "' has no mass, so its centre of mass is undefined");
+  setBodies(*this, indices, answer);
+  answer.masses.resize(n);
+  answer.com.resize(K * n * 3);
+  answer.jacobians.resize(jacobians ? K * 3 * layout.D : 0);
+  answer.acceleration_bias.resize(jacobians ? K * n * 3 : 0);
+  forEachBodySlot(*this, layout, indices, K, current, q, answer.cos_theta, [&](const detail::BodySlot& slot) {
+    answer.masses[slot.n % n] = diff_rigid_body::centerOfMass(
+        scene_.bodies[slot.body], workspace(slot.body), slot.x, slice(qdot, slot.v), answer.com.data() + 3 * slot.n,
+        jacobians ? answer.jacobians.data() + 3 * slot.v : nullptr,
+        jacobians ? answer.acceleration_bias.data() + 3 * slot.n : nullptr);
+  });
+  requireFiniteResults({ { "result com", &answer.com },
+                         { "result jacobians", &answer.jacobians },
+                         { "result acceleration_bias", &answer.acceleration_bias } });
+}
+
+}  // namespace diff_rigid_body
