@@ -252,5 +252,43 @@ inline void probe(const std::shared_ptr<Instance>& instance, const std::shared_p
   instance->busy = false;
 }
 
+/// get_bodies of every instance, concurrently on their workers (each waits up to `timeout` [s] for
+/// the service). Per instance: its answer, or the error of an unreachable one; `finished` says
+/// which answered or failed within timeout + 5 s.
+struct SceneAnswers
+{
+  using Piece = std::pair<diff_rigid_body::GetBodies, std::exception_ptr>;
+  std::shared_ptr<Round<Piece>> round = std::make_shared<Round<Piece>>();
+  std::deque<bool> finished;
+};
+inline SceneAnswers askScenes(const std::vector<std::shared_ptr<Instance>>& instances, double timeout)
+{
+  SceneAnswers answers;
+  auto round = answers.round;
+  for (std::size_t i = 0; i < instances.size(); ++i)
+  {
+    round->pieces.emplace_back();
+    round->finished.push_back(false);
+    instances[i]->worker.submit([round, i, instance = instances[i], timeout] {
+      SceneAnswers::Piece& piece = round->pieces[i];
+      try
+      {
+        if (!ros::service::waitForService(instance->server + "/get_bodies", ros::Duration(timeout)))
+          throw ConnectionError(
+              diff_rigid_body_ros::detail::missingNodeMessage(instance->server, instance->server + "/get_bodies",
+                                                              timeout));
+        instance->client.call("get_bodies", piece.first);
+      }
+      catch (...)
+      {
+        piece.second = std::current_exception();
+      }
+      round->finish(i);
+    });
+  }
+  answers.finished = round->wait(std::chrono::duration<double>(timeout + 5.0));
+  return answers;
+}
+
 }  // namespace pool
 }  // namespace diff_rigid_body_ros

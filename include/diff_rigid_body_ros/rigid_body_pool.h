@@ -189,30 +189,9 @@ private:
   /// scene throws PoolError.
   void checkScenes()
   {
-    using Piece = std::pair<diff_rigid_body::GetBodies, std::exception_ptr>;
-    auto round = std::make_shared<pool::Round<Piece>>();
-    const double timeout = shared_->options.timeout;
-    for (std::size_t i = 0; i < instances_.size(); ++i)
-    {
-      round->pieces.emplace_back();
-      round->finished.push_back(false);
-      instances_[i]->worker.submit([round, i, instance = instances_[i], timeout] {
-        Piece& piece = round->pieces[i];
-        try
-        {
-          if (!ros::service::waitForService(instance->server + "/get_bodies", ros::Duration(timeout)))
-            throw ConnectionError(detail::missingNodeMessage(instance->server, instance->server + "/get_bodies",
-                                                             timeout));
-          instance->client.call("get_bodies", piece.first);
-        }
-        catch (...)
-        {
-          piece.second = std::current_exception();
-        }
-        round->finish(i);
-      });
-    }
-    const std::deque<bool> finished = round->wait(std::chrono::duration<double>(timeout + 5.0));
+    const pool::SceneAnswers answers = pool::askScenes(instances_, shared_->options.timeout);
+    const std::deque<bool>& finished = answers.finished;
+    const auto& round = answers.round;
     bool have_scene = false;
     for (std::size_t i = 0; i < instances_.size(); ++i)
     {
