@@ -1,0 +1,58 @@
+// Frames that do not move with the body (docs/interface.md, ~get_frame_jacobians):
+// a static link below the URDF's root and the fixed frame itself answer their
+// fixed pose, zero Jacobian columns and zero acceleration bias. The expected
+// poses are the URDF's own numbers, not the loader's.
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "diff_rigid_body/services/scene_queries.h"
+#include "../support/urdf_builders.h"
+
+namespace drb = diff_rigid_body;
+using namespace drb_test::urdf;
+
+namespace
+{
+// world -> table (fixed, 0.5 m up, rotated 90 deg about z) -> box (floating, 1 m above the table).
+const std::string kTableScene =
+    robot(link("table", collision(boxGeometry("1 1 1"))) + link("box", inertial()) +
+          joint("fixed", "world", "table", "<origin xyz=\"0 0 0.5\" rpy=\"0 0 1.5707963267948966\"/>") +
+          floatingJoint("box", "<origin xyz=\"0 0 1\"/>", "table"));
+
+TEST(StaticFrames, AStaticLinkAndTheFixedFrameHaveTheirPoseAndNoColumns)
+{
+  const drb::SceneQueries queries(drb::loadSceneFromUrdf(kTableScene, drb::SceneOptions()), drb::standardGravity());
+  const std::vector<double> q{ 0.3, -0.2, 0.1, 0.4, 0.5, 1.6 }, qdot{ 1, 2, 3, 4, 5, 6 };
+  drb::FrameJacobianAnswer answer;
+  for (std::uint32_t reference = 0; reference < 3; ++reference)
+  {
+    queries.frameJacobians(queries.initialState(), "box", { "table", "world", "box" }, q, qdot, reference, true,
+                           answer);
+    ASSERT_EQ(answer.frames, (std::vector<std::string>{ "table", "world", "box" }));
+    ASSERT_EQ(answer.dofs, 6u);
+    // table: p = (0, 0, 0.5), R = Rz(pi/2) row-major.
+    const std::vector<double> table_pose{ 0, 0, 0.5, 0, -1, 0, 1, 0, 0, 0, 0, 1 };
+    const std::vector<double> world_pose{ 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1 };
+    for (int i = 0; i < 12; ++i)
+    {
+      EXPECT_NEAR(answer.poses[i], table_pose[i], 1e-15) << "table pose value " << i;
+      EXPECT_EQ(answer.poses[12 + i], world_pose[i]) << "world pose value " << i;
+    }
+    for (int i = 0; i < 2 * 36; ++i)
+      EXPECT_EQ(answer.jacobians[i], 0.0) << "static frame column value " << i << ", reference " << reference;
+    for (int i = 0; i < 12; ++i)
+      EXPECT_EQ(answer.acceleration_bias[i], 0.0) << "static frame bias value " << i;
+    // The moving frame in the same answer is not zero: its position is q's translation.
+    EXPECT_NEAR(answer.poses[24 + 0], 0.4, 1e-15);
+    EXPECT_NEAR(answer.poses[24 + 2], 1.6, 1e-15);
+    double moving = 0.0;
+    for (int i = 72; i < 108; ++i)
+      moving += std::abs(answer.jacobians[i]);
+    EXPECT_GT(moving, 1.0);
+  }
+}
+}  // namespace
