@@ -337,6 +337,7 @@ bool RigidBodyServer::forwardDynamics(ForwardDynamics::Request& request, Forward
 bool RigidBodyServer::getFrameJacobians(GetFrameJacobians::Request& request, GetFrameJacobians::Response& response)
 {
   return serveAnswer<FrameJacobianAnswer>(response, "get_frame_jacobians", [&](FrameJacobianAnswer& answer) {
+    node::removeFramePrefix(frame_prefix_, request.frames);  // "a/link" as tf names it, or "link"
     queries_.frameJacobians(*snapshot(), request.body, request.frames, request.q, request.qdot, request.reference,
                             request.acceleration_bias, answer);
   });

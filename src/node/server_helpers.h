@@ -52,6 +52,17 @@ inline std::string failureMessage(const std::exception& error, const std::string
   return message;
 }
 
+/// Frame names as tf knows them (with ~frame_prefix) to the scene's URDF
+/// names: `prefix` is removed from the start of each name that has it.
+inline void removeFramePrefix(const std::string& prefix, std::vector<std::string>& names)
+{
+  if (prefix.empty())
+    return;
+  for (std::string& name : names)
+    if (name.size() > prefix.size() && name.compare(0, prefix.size(), prefix) == 0)
+      name.erase(0, prefix.size());
+}
+
 /// Runs `work`; any exception becomes success=false with failureMessage, so
 /// that the client receives it, nothing changed, and the node keeps serving.
 /// Returns true for roscpp.

@@ -142,6 +142,19 @@ class Frames(unittest.TestCase):
         self.assertTrue(np.array_equal(answer.rotations[0], pose[:3, :3]))
         self.assertFalse(answer.J.any() or answer.bias.any())
 
+    def test_f_frames_may_carry_the_frame_prefix_as_tf_names_them(self):
+        second = RigidBodyClient('/second/rigid_body_server', timeout=WAIT)  # ~frame_prefix second/
+        x = self.random_x()
+        frames = ['panda_link4', 'panda_link0']
+        plain = second.frame_jacobians(self.body, q=x, frames=frames, acceleration_bias=True)
+        prefixed = second.frame_jacobians(self.body, q=x, frames=['second/' + f for f in frames], acceleration_bias=True)
+        self.assertEqual(list(prefixed.frames), frames)
+        for field in ('positions', 'rotations', 'J', 'bias'):
+            self.assertTrue(np.array_equal(getattr(prefixed, field), getattr(plain, field)), field)
+        with self.assertRaises(DiffRigidBodyError) as caught:  # another instance's prefix is not this one's
+            second.frame_jacobians(self.body, q=x, frames=['third/panda_link4'])
+        self.assertIn("unknown frame 'third/panda_link4'", caught.exception.message)
+
     def urdf_links(self):
         return {j['parent'] for j in self.urdf_joints.values()} | {j['child'] for j in self.urdf_joints.values()}
 
