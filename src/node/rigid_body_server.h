@@ -98,7 +98,7 @@ private:
   void publishStaticLinks();
 
   // The service handlers, one per entry of DIFF_RIGID_BODY_SERVICES (diff_rigid_body_ros/services.h).
-#define DRB_DECLARE_HANDLER(name, srv_type, handler, python_method, cpp_method, benchmark_only)                         \
+#define DRB_DECLARE_HANDLER(name, srv_type, handler, python_method, cpp_method, benchmark_only)                        \
   bool handler(srv_type::Request& request, srv_type::Response& response);
   DIFF_RIGID_BODY_SERVICES(DRB_DECLARE_HANDLER)
 #undef DRB_DECLARE_HANDLER

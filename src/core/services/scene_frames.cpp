@@ -15,10 +15,7 @@ namespace diff_rigid_body
 {
 using detail::checkDynamicsBudget;
 using detail::dynamicsConfigurations;
-using detail::forEachBodySlot;
 using detail::reject;
-using detail::requireFiniteResults;
-using detail::setBodies;
 using detail::slice;
 
 namespace
@@ -169,7 +166,7 @@ void SceneQueries::frameJacobians(const SceneState& current, const std::string& 
     }
     answer.cos_theta[k] = body.hasFreeRoot() ? std::cos(x[THETA]) : 1.0;
   }
-  requireFiniteResults({ { "result poses", &answer.poses },
+  detail::requireFiniteResults({ { "result poses", &answer.poses },
                          { "result jacobians", &answer.jacobians },
                          { "result acceleration_bias", &answer.acceleration_bias } });
 }
@@ -188,18 +185,18 @@ void SceneQueries::centerOfMass(const SceneState& current, const std::vector<std
     if (!(scene_.bodies[indices[i]].mass() > 0.0))
       reject("bodies[" + std::to_string(i) + "]: body '" + scene_.bodies[indices[i]].name +
              "' has no mass, so its centre of mass is undefined");
-  setBodies(*this, indices, answer);
+  detail::setBodies(*this, indices, answer);
   answer.masses.resize(n);
   answer.com.resize(K * n * 3);
   answer.jacobians.resize(jacobians ? K * 3 * layout.D : 0);
   answer.acceleration_bias.resize(jacobians ? K * n * 3 : 0);
-  forEachBodySlot(*this, layout, indices, K, current, q, answer.cos_theta, [&](const detail::BodySlot& slot) {
+  detail::forEachBodySlot(*this, layout, indices, K, current, q, answer.cos_theta, [&](const detail::BodySlot& slot) {
     answer.masses[slot.n % n] = diff_rigid_body::centerOfMass(
         scene_.bodies[slot.body], workspace(slot.body), slot.x, slice(qdot, slot.v), answer.com.data() + 3 * slot.n,
         jacobians ? answer.jacobians.data() + 3 * slot.v : nullptr,
         jacobians ? answer.acceleration_bias.data() + 3 * slot.n : nullptr);
   });
-  requireFiniteResults({ { "result com", &answer.com },
+  detail::requireFiniteResults({ { "result com", &answer.com },
                          { "result jacobians", &answer.jacobians },
                          { "result acceleration_bias", &answer.acceleration_bias } });
 }
