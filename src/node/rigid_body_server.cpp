@@ -8,12 +8,12 @@
 #include <geometry_msgs/TransformStamped.h>
 #include <tf2_msgs/TFMessage.h>
 
+#include "diff_rigid_body/services/bodies_answer.h"
 #include "diff_rigid_body/exceptions.h"
 #include "diff_rigid_body/state/state_file.h"
 
 namespace diff_rigid_body
 {
-using node::appendMatrix;
 using node::serve;
 using node::serveAnswer;
 using node::setTransform;
@@ -200,30 +200,24 @@ void RigidBodyServer::publishStaticLinks()
 bool RigidBodyServer::getBodies(GetBodies::Request&, GetBodies::Response& response)
 {
   return serve(response, "get_bodies", [&] {
-    response.fixed_frame = frame_prefix_ + queries_.scene().fixed_frame;
-    for (const BodyModel& body : queries_.scene().bodies)
-    {
-      const Segment& root = body.segments.front();
-      response.names.push_back(body.name);
-      response.masses.push_back(body.mass());
-      appendMatrix(root.inertia.inertia, response.inertias);
-      appendMatrix(body.rootComOffset(), response.com_offsets);
-      response.vertex_counts.push_back(static_cast<std::uint32_t>(body.vertexCount()));
-      response.dofs.push_back(static_cast<std::uint32_t>(body.coordinates));
-      response.joint_counts.push_back(static_cast<std::uint32_t>(body.joint_names.size()));
-      response.joint_names.insert(response.joint_names.end(), body.joint_names.begin(), body.joint_names.end());
-      response.joint_lower.insert(response.joint_lower.end(), body.joint_lower.begin(), body.joint_lower.end());
-      response.joint_upper.insert(response.joint_upper.end(), body.joint_upper.begin(), body.joint_upper.end());
-      response.link_counts.push_back(static_cast<std::uint32_t>(body.links.size()));
-      for (const LinkInBody& link : body.links)
-      {
-        response.link_names.push_back(link.name);
-        response.link_vertex_counts.push_back(link.new_vertex_count);
-        response.link_masses.push_back(link.mass_properties.mass);
-        appendMatrix(link.mass_properties.inertia, response.link_inertias);
-        appendMatrix(link.mass_properties.com, response.link_com_offsets);
-      }
-    }
+    BodiesAnswer answer = describeBodies(queries_.scene());
+    response.fixed_frame = frame_prefix_ + answer.fixed_frame;
+    response.names = std::move(answer.names);
+    response.masses = std::move(answer.masses);
+    response.inertias = std::move(answer.inertias);
+    response.com_offsets = std::move(answer.com_offsets);
+    response.vertex_counts = std::move(answer.vertex_counts);
+    response.dofs = std::move(answer.dofs);
+    response.joint_names = std::move(answer.joint_names);
+    response.joint_counts = std::move(answer.joint_counts);
+    response.joint_lower = std::move(answer.joint_lower);
+    response.joint_upper = std::move(answer.joint_upper);
+    response.link_names = std::move(answer.link_names);
+    response.link_counts = std::move(answer.link_counts);
+    response.link_vertex_counts = std::move(answer.link_vertex_counts);
+    response.link_masses = std::move(answer.link_masses);
+    response.link_inertias = std::move(answer.link_inertias);
+    response.link_com_offsets = std::move(answer.link_com_offsets);
   });
 }
 

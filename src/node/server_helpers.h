@@ -132,15 +132,6 @@ bool runAtStart(const std::string& what, Work&& work)
   return false;
 }
 
-/// Appends `matrix` row-major to `out`.
-template <typename Matrix>
-void appendMatrix(const Matrix& matrix, std::vector<double>& out)
-{
-  for (Eigen::Index r = 0; r < matrix.rows(); ++r)
-    for (Eigen::Index c = 0; c < matrix.cols(); ++c)
-      out.push_back(matrix(r, c));
-}
-
 /// Advertises `handler` for the service Srv with bounded request decoding
 /// (bounded_request.h): a request refused there gets success=false and the
 /// refusal, and never reaches the handler.
