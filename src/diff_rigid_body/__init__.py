@@ -2,6 +2,8 @@
 
 ``diff_rigid_body.client``: :class:`RigidBodyClient` (numpy arrays over
 persistent service connections) and :class:`DiffRigidBodyError`.
+``diff_rigid_body.local``: :class:`LocalScene`, the same queries answered in process by the
+node's core (``diff_rigid_body._local``), without a node.
 ``diff_rigid_body.pool``: :class:`RigidBodyPool` (the same methods over several
 instances: K configurations sharded, failover) and :class:`PoolError`.
 ``diff_rigid_body.pose_fitting`` and ``diff_rigid_body.trajectory_energy``:
@@ -19,6 +21,9 @@ def __getattr__(name):
                 'InverseDynamicsResult', 'ForwardDynamicsResult', 'FrameJacobians', 'CenterOfMass'):
         from diff_rigid_body import client
         return getattr(client, name)
+    if name == 'LocalScene':
+        from diff_rigid_body import local
+        return local.LocalScene
     if name in ('RigidBodyPool', 'PoolError'):
         from diff_rigid_body import pool
         return getattr(pool, name)
