@@ -10,9 +10,10 @@ A local scene answers the state-free methods of
 compiled module ``diff_rigid_body._local`` calls the very SceneQueries members that the node's
 service handlers call. It has no state, so every ``q`` is required (a missing one is refused).
 Refusals raise :class:`~diff_rigid_body.client_types.DiffRigidBodyError` with the node's message
-(its ``service`` is the node's service name, or ``'load'``). Answers are numpy arrays that own the
-core's buffers (no copy on the way out); inputs are read through the buffer protocol. Several
-threads may call one scene at once: the core runs without the GIL, with one workspace per thread.
+(its ``service`` is the node's service name, or ``'load'``). No copies either way: answers are
+numpy arrays that own the core's buffers, and C-contiguous float64 inputs are read by the core in
+place (do not modify one while a call reads it). Several threads may call one scene at once: the
+core runs without the GIL, with one workspace per thread.
 """
 import types
 

@@ -3,8 +3,9 @@
 // Out: an answer's std::vector is moved to the heap and handed to numpy as
 // the buffer of a 1-D array whose base is a capsule that frees it, so no
 // value is copied. In: an InputArray is read through the buffer protocol
-// (forcecast converts only what is not already C-contiguous of its dtype);
-// the core's request vectors take one copy of its values.
+// (forcecast converts only what is not already C-contiguous of its dtype),
+// and the core reads its float64 values in place (ArrayView); vertex index
+// lists are copied into the std::vector the core takes.
 #pragma once
 
 #include <cstddef>
@@ -14,6 +15,8 @@
 #include <vector>
 
 #include <pybind11/numpy.h>
+
+#include "diff_rigid_body/services/array_view.h"
 
 namespace diff_rigid_body
 {
@@ -46,6 +49,7 @@ struct Values
   std::size_t size = 0;
 
   explicit Values(const InputArray<T>& array) : data(array.data()), size(static_cast<std::size_t>(array.size())) {}
+  ArrayView<T> view() const { return ArrayView<T>(data, size); }
   std::vector<T> vector() const { return std::vector<T>(data, data + size); }
 };
 

@@ -58,6 +58,10 @@ PYBIND11_MODULE(_local, m)
   m.doc() = "The diff_rigid_body core in process; use diff_rigid_body.LocalScene.";
   registerRefusal();
   using namespace pybind11::literals;
+  // Where the core reads a float64 input: the array's own buffer when it is C-contiguous float64.
+  m.def("buffer_address", [](const InputArray<double>& values) {
+    return reinterpret_cast<std::uintptr_t>(diff_rigid_body::python::Values<double>(values).data);
+  }, "values"_a);
   py::class_<LocalScene>(m, "Scene")
       .def(py::init(&load), "urdf"_a, "is_path"_a, "geometry"_a = "collision", "bodies"_a = std::vector<std::string>(),
            "density"_a = py::none(), "joints"_a = "model", "strict_inertia"_a = false, "floating_base"_a = false,

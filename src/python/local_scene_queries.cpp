@@ -74,7 +74,7 @@ py::dict LocalScene::getMassMatrix(const std::vector<std::string>& bodies, const
 {
   const Values<double> x = requiredQ(q, "get_mass_matrix");
   MassMatrixAnswer answer;
-  serve("get_mass_matrix", [&] { queries_->massMatrices(state_, bodies, x.vector(), derivatives, answer); });
+  serve("get_mass_matrix", [&] { queries_->massMatrices(state_, bodies, x.view(), derivatives, answer); });
   py::dict r;
   r["bodies"] = answer.bodies;
   r["dofs"] = adopt(std::move(answer.dofs));
@@ -91,7 +91,7 @@ py::dict LocalScene::getVertexJacobians(const std::string& body, const InputArra
   const Values<std::uint32_t> selected(vertices);
   std::vector<double> positions, jacobians;
   serve("get_vertex_jacobians",
-        [&] { queries_->vertexJacobians(state_, body, selected.vector(), x.vector(), positions, jacobians); });
+        [&] { queries_->vertexJacobians(state_, body, selected.vector(), x.view(), positions, jacobians); });
   py::dict r;
   r["positions"] = adopt(std::move(positions));
   r["jacobians"] = adopt(std::move(jacobians));
@@ -109,7 +109,7 @@ py::dict LocalScene::getVertexJacobiansCompact(const std::string& body, const In
   {
     std::vector<float> positions, jacobians;
     serve("get_vertex_jacobians_compact", [&] {
-      queries_->vertexRotationJacobians(state_, body, selected.vector(), x.vector(), positions_only, positions,
+      queries_->vertexRotationJacobians(state_, body, selected.vector(), x.view(), positions_only, positions,
                                         jacobians);
     });
     r["positions_f32"] = adopt(std::move(positions));
@@ -118,7 +118,7 @@ py::dict LocalScene::getVertexJacobiansCompact(const std::string& body, const In
   }
   std::vector<double> positions, jacobians;
   serve("get_vertex_jacobians_compact", [&] {
-    queries_->vertexRotationJacobians(state_, body, selected.vector(), x.vector(), positions_only, positions,
+    queries_->vertexRotationJacobians(state_, body, selected.vector(), x.view(), positions_only, positions,
                                       jacobians);
   });
   r["positions"] = adopt(std::move(positions));
@@ -134,7 +134,7 @@ py::dict LocalScene::backprop(const std::string& body, const InputArray<std::uin
   const Values<double> dl_dp(gradients);
   std::vector<double> gradient;
   serve("backprop", [&] {
-    queries_->backpropConfigurations(state_, body, selected.vector(), dl_dp.vector(), x.vector(), gradient);
+    queries_->backpropConfigurations(state_, body, selected.vector(), dl_dp.view(), x.view(), gradient);
   });
   py::dict r;
   r["gradient"] = adopt(std::move(gradient));
@@ -148,7 +148,7 @@ py::dict LocalScene::inverseDynamics(const std::vector<std::string>& bodies, con
   const Values<double> x = requiredQ(q, "inverse_dynamics"), v(qdot), a(qddot);
   InverseDynamicsAnswer answer;
   serve("inverse_dynamics", [&] {
-    queries_->inverseDynamics(state_, bodies, x.vector(), v.vector(), a.vector(), coriolis_matrices, derivatives,
+    queries_->inverseDynamics(state_, bodies, x.view(), v.view(), a.view(), coriolis_matrices, derivatives,
                               answer);
   });
   py::dict r;
@@ -171,7 +171,7 @@ py::dict LocalScene::forwardDynamics(const std::vector<std::string>& bodies, con
   const Values<double> x = requiredQ(q, "forward_dynamics"), v(qdot), t(tau);
   ForwardDynamicsAnswer answer;
   serve("forward_dynamics", [&] {
-    queries_->forwardDynamics(state_, bodies, x.vector(), v.vector(), t.vector(), derivatives, answer);
+    queries_->forwardDynamics(state_, bodies, x.view(), v.view(), t.view(), derivatives, answer);
   });
   py::dict r;
   r["bodies"] = answer.bodies;
@@ -191,7 +191,7 @@ py::dict LocalScene::getFrameJacobians(const std::string& body, const std::vecto
   const Values<double> x = requiredQ(q, "get_frame_jacobians"), v(qdot);
   FrameJacobianAnswer answer;
   serve("get_frame_jacobians", [&] {
-    queries_->frameJacobians(state_, body, frames, x.vector(), v.vector(), reference, acceleration_bias, answer);
+    queries_->frameJacobians(state_, body, frames, x.view(), v.view(), reference, acceleration_bias, answer);
   });
   py::dict r;
   r["frames"] = answer.frames;
@@ -209,7 +209,7 @@ py::dict LocalScene::getCenterOfMass(const std::vector<std::string>& bodies, con
   const Values<double> x = requiredQ(q, "get_center_of_mass"), v(qdot);
   CenterOfMassAnswer answer;
   serve("get_center_of_mass",
-        [&] { queries_->centerOfMass(state_, bodies, x.vector(), v.vector(), jacobians, answer); });
+        [&] { queries_->centerOfMass(state_, bodies, x.view(), v.view(), jacobians, answer); });
   py::dict r;
   r["bodies"] = answer.bodies;
   r["dofs"] = adopt(std::move(answer.dofs));

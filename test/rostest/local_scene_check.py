@@ -4,7 +4,8 @@ the same answers bit for bit (np.array_equal, never a tolerance) for every state
 the Panda, the UR5 (a gravity of its own), simple_humanoid with a floating base and the default
 scene of free bodies. Also: refusals raise DiffRigidBodyError with the node's message; an answer's
 arrays are views of the buffer the core filled (their base is the module's capsule, not a numpy
-copy); threads calling one scene at once get the answers of serial calls.
+copy); float64 inputs reach the core as the caller's buffers; threads calling one scene at once get
+the answers of serial calls.
 """
 import concurrent.futures
 import sys
@@ -14,7 +15,7 @@ import numpy as np
 import rospy
 import rostest
 
-from diff_rigid_body import LocalScene
+from diff_rigid_body import LocalScene, _local
 from diff_rigid_body.client import DiffRigidBodyError, RigidBodyClient
 
 WAIT = 60.0
@@ -145,6 +146,38 @@ class LocalSceneAgainstNode(unittest.TestCase):
             self.assertFalse(array.flags.owndata)
             self.assertEqual(type(owner(array)).__name__, 'PyCapsule')
         self.assertFalse(np.shares_memory(positions, J))
+
+    def test_f_inputs_reach_the_core_in_place(self):
+        """Through LocalScene's methods, C-contiguous float64 q and gradients arrive at the module
+        as the caller's own buffers (the address the core reads); a float32 q is converted."""
+        local, _, bodies = self.pairs['panda']
+        body, count = bodies.names[0], int(bodies.vertex_counts[0])
+        seen = {}
+        module_scene = local._scene
+
+        class Recorder(object):
+            def __getattr__(self, name):
+                def call(**fields):
+                    seen.update((field, _local.buffer_address(value)) for field, value in fields.items()
+                                if isinstance(value, np.ndarray) and value.dtype == np.float64)
+                    return getattr(module_scene, name)(**fields)
+                return call
+
+        def address(array):
+            return array.__array_interface__['data'][0]
+
+        q, gradients = self.configurations(bodies), rng.standard_normal((K, count, 3))
+        local._scene = Recorder()
+        try:
+            local.backprop(body, gradients, q)
+            self.assertEqual((seen['q'], seen['gradients']), (address(q), address(gradients)))
+            local.forward_dynamics(q=q, qdot=q[::-1].copy(), tau=q)
+            self.assertEqual((seen['q'], seen['tau']), (address(q), address(q)))
+            q32 = q.astype(np.float32)
+            local.mass_matrix(q=q32)
+            self.assertNotEqual(seen['q'], address(q32))
+        finally:
+            local._scene = module_scene
 
     def test_g_threads_share_one_scene(self):
         local, _, bodies = self.pairs['humanoid']

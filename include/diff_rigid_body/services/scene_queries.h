@@ -4,6 +4,9 @@
 //
 // Every function validates its whole request before it allocates or writes
 // anything, and throws InvalidArgumentError naming the field, index or body.
+// Float64 request arrays (q, qdot, qddot, tau, gradients) are DoubleViews
+// (services/array_view.h): read in place, from a message's vectors or a caller's own
+// buffers, for the duration of the call.
 #pragma once
 
 #include <cstdint>
@@ -14,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "diff_rigid_body/services/array_view.h"
 #include "diff_rigid_body/multibody/body_workspace.h"
 #include "diff_rigid_body/parsers/urdf_scene.h"
 #include "diff_rigid_body/algorithm/vertex_jacobians.h"
@@ -223,10 +227,10 @@ public:
   /// empty. At most RequestLimits::kMaxMassMatrixDoubles answer doubles
   /// (...WithDerivatives when `derivatives`). `answer` is overwritten (its
   /// buffers reused); on refusal it holds no answer.
-  void massMatrices(const SceneState& current, const std::vector<std::string>& names, const std::vector<double>& q,
+  void massMatrices(const SceneState& current, const std::vector<std::string>& names, DoubleView q,
                     bool derivatives, MassMatrixAnswer& answer) const;
   MassMatrixAnswer massMatrices(const SceneState& current, const std::vector<std::string>& names,
-                                const std::vector<double>& q, bool derivatives) const;
+                                DoubleView q, bool derivatives) const;
 
   /// Positions (3 per vertex, fixed frame) and Jacobians dp/dx (3 d per
   /// vertex, 3 x d row-major; 18 for a free object) of the N selected
@@ -239,7 +243,7 @@ public:
   /// is refused (vertexOutputBound). Outputs are resized here, and untouched
   /// on refusal.
   void vertexJacobians(const SceneState& current, const std::string& body, const std::vector<std::uint32_t>& vertices,
-                       const std::vector<double>& q, std::vector<double>& positions,
+                       DoubleView q, std::vector<double>& positions,
                        std::vector<double>& jacobians) const;
 
   /// The reduced transport of vertexJacobians (~get_vertex_jacobians_compact):
@@ -252,7 +256,7 @@ public:
   /// Out = double and float.
   template <typename Out>
   void vertexRotationJacobians(const SceneState& current, const std::string& body,
-                               const std::vector<std::uint32_t>& vertices, const std::vector<double>& q,
+                               const std::vector<std::uint32_t>& vertices, DoubleView q,
                                bool positions_only, std::vector<Out>& positions,
                                std::vector<Out>& rotation_jacobians) const;
 
@@ -263,20 +267,20 @@ public:
   /// call with its x and gradients alone would give them, same bits; its
   /// buffer is reused, and it is left empty on refusal).
   void backpropConfigurations(const SceneState& current, const std::string& body,
-                              const std::vector<std::uint32_t>& vertices, const std::vector<double>& gradients,
-                              const std::vector<double>& q, std::vector<double>& gradient) const;
+                              const std::vector<std::uint32_t>& vertices, DoubleView gradients,
+                              DoubleView q, std::vector<double>& gradient) const;
   std::vector<double> backpropConfigurations(const SceneState& current, const std::string& body,
                                              const std::vector<std::uint32_t>& vertices,
-                                             const std::vector<double>& gradients,
-                                             const std::vector<double>& q) const;
+                                             DoubleView gradients,
+                                             DoubleView q) const;
 
   /// Columns per row of body `index`'s compact Jacobian (see vertexRotationJacobians).
   std::size_t compactColumns(std::size_t index) const { return compact_columns_[index].width; }
 
   /// backpropConfigurations for one configuration (`q` empty or d values).
   Eigen::VectorXd backprop(const SceneState& current, const std::string& body,
-                           const std::vector<std::uint32_t>& vertices, const std::vector<double>& gradients,
-                           const std::vector<double>& q) const;
+                           const std::vector<std::uint32_t>& vertices, DoubleView gradients,
+                           DoubleView q) const;
 
   /// Inverse dynamics of the bodies `names` (empty = all) at K
   /// configurations (q: K D values, D the sum of their d; empty = the
@@ -287,8 +291,8 @@ public:
   /// bodies, lengths that do not match, non-finite values, answers over
   /// RequestLimits' budgets; after: a result that is not finite.
   void inverseDynamics(const SceneState& current, const std::vector<std::string>& names,
-                       const std::vector<double>& q, const std::vector<double>& qdot,
-                       const std::vector<double>& qddot, bool coriolis, bool derivatives,
+                       DoubleView q, DoubleView qdot,
+                       DoubleView qddot, bool coriolis, bool derivatives,
                        InverseDynamicsAnswer& answer) const;
 
   /// Forward dynamics x'' (forward_dynamics.h), with `derivatives`
@@ -296,7 +300,7 @@ public:
   /// (tau in place of qddot). A configuration where M is singular refuses the
   /// whole request, naming the body, the configuration and why.
   void forwardDynamics(const SceneState& current, const std::vector<std::string>& names,
-                       const std::vector<double>& q, const std::vector<double>& qdot, const std::vector<double>& tau,
+                       DoubleView q, DoubleView qdot, DoubleView tau,
                        bool derivatives, ForwardDynamicsAnswer& answer) const;
 
   /// Poses, Jacobians (in `reference`: 0 WORLD, 1 LOCAL, 2
@@ -312,14 +316,14 @@ public:
   /// values, an answer over RequestLimits::kMaxMassMatrixDoublesWithDerivatives;
   /// after: a result that is not finite.
   void frameJacobians(const SceneState& current, const std::string& body, const std::vector<std::string>& frames,
-                      const std::vector<double>& q, const std::vector<double>& qdot, std::uint32_t reference,
+                      DoubleView q, DoubleView qdot, std::uint32_t reference,
                       bool acceleration_bias, FrameJacobianAnswer& answer) const;
 
   /// Centre of mass of the bodies `names` (empty = all), and with
   /// `jacobians` its Jacobian and acceleration bias, laid out and checked as
   /// inverseDynamics (qdot in place of qddot); a massless body is refused.
-  void centerOfMass(const SceneState& current, const std::vector<std::string>& names, const std::vector<double>& q,
-                    const std::vector<double>& qdot, bool jacobians, CenterOfMassAnswer& answer) const;
+  void centerOfMass(const SceneState& current, const std::vector<std::string>& names, DoubleView q,
+                    DoubleView qdot, bool jacobians, CenterOfMassAnswer& answer) const;
 
   /// This thread's workspace for body `index`, made on first use and kept
   /// for the thread's next calls on this SceneQueries: queries allocate
@@ -330,22 +334,22 @@ private:
   /// K for a request's `q` (empty = 1, else its size / d), checked against
   /// its size (a multiple of d = dofs(index)), the vertex limit for K x
   /// `vertex_count`, and the answer limit for `width` columns.
-  std::size_t configurationCount(const std::vector<double>& q, std::size_t index, std::size_t vertex_count,
+  std::size_t configurationCount(DoubleView q, std::size_t index, std::size_t vertex_count,
                                  std::size_t width) const;
   /// The d values of configuration k of body `index`: q + d k, or the current state when `q` is empty.
-  const double* configurationQ(const SceneState& current, std::size_t index, const std::vector<double>& q,
+  const double* configurationQ(const SceneState& current, std::size_t index, DoubleView q,
                                std::size_t k) const;
   /// Checks every index of `vertices` against body `index`.
   std::size_t checkVertices(std::size_t index, const std::vector<std::uint32_t>& vertices) const;
   /// Refuses, naming the configuration when there are several, a
   /// configuration whose vertexOutputBound exceeds `limit`.
   void checkOutputsFit(const SceneState& current, std::size_t index, const JacobianColumns& columns,
-                       const std::vector<std::uint32_t>& vertices, const std::vector<double>& q,
+                       const std::vector<std::uint32_t>& vertices, DoubleView q,
                        std::size_t configurations, double limit, const char* suffix) const;
   /// The vertex query behind vertexJacobians and vertexRotationJacobians.
   template <typename Out>
   void vertexQuery(const SceneState& current, const std::string& body, const std::vector<std::uint32_t>& vertices,
-                   const std::vector<double>& q, bool compact, bool positions_only, std::vector<Out>& positions,
+                   DoubleView q, bool compact, bool positions_only, std::vector<Out>& positions,
                    std::vector<Out>& jacobians) const;
   /// Refuses a get_mass_matrix answer over the budget of doubles.
   void checkMassMatrixBudget(std::size_t configurations, std::size_t bodies, std::size_t per_configuration,

@@ -55,8 +55,8 @@ inline const RequestLayout& requestLayout(const SceneQueries& queries, const std
 /// The K of a dynamics request: from q (K D values; empty = 1), with each
 /// other array of q's length (K D) or empty, every value finite.
 inline std::size_t dynamicsConfigurations(const detail::RequestLayout& layout, std::size_t bodies,
-                                   const std::vector<double>& q,
-                                   std::initializer_list<std::pair<const char*, const std::vector<double>*>> others)
+                                   DoubleView q,
+                                   std::initializer_list<std::pair<const char*, const DoubleView*>> others)
 {
   if (!q.empty() && (bodies == 0 || q.size() % layout.D != 0))
     detail::reject(detail::sizeMismatch("q",
@@ -118,7 +118,7 @@ struct BodySlot
 /// values): cos(theta) of a free root (0 at gimbal lock), 1 for a fixed base.
 template <typename Visit>
 void forEachBodySlot(const SceneQueries& queries, const RequestLayout& layout, const std::vector<std::size_t>& indices,
-                     std::size_t K, const SceneState& current, const std::vector<double>& q,
+                     std::size_t K, const SceneState& current, DoubleView q,
                      std::vector<double>& cos_theta, Visit&& visit)
 {
   const std::size_t n = indices.size();
@@ -141,7 +141,7 @@ inline void requireFiniteResults(std::initializer_list<std::pair<const char*, co
     requireFinite(values->data(), values->size(), field);
 }
 
-inline const double* slice(const std::vector<double>& values, std::size_t offset)
+inline const double* slice(DoubleView values, std::size_t offset)
 {
   return values.empty() ? nullptr : values.data() + offset;
 }

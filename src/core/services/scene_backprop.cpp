@@ -15,7 +15,7 @@ using detail::sizeMismatch;
 
 void SceneQueries::backpropConfigurations(const SceneState& current, const std::string& body_name,
                                           const std::vector<std::uint32_t>& vertices,
-                                          const std::vector<double>& gradients, const std::vector<double>& q,
+                                          DoubleView gradients, DoubleView q,
                                           std::vector<double>& gradient) const
 {
   const std::size_t index = bodyIndex(body_name, "body");
@@ -62,8 +62,8 @@ void SceneQueries::backpropConfigurations(const SceneState& current, const std::
 
 std::vector<double> SceneQueries::backpropConfigurations(const SceneState& current, const std::string& body,
                                                          const std::vector<std::uint32_t>& vertices,
-                                                         const std::vector<double>& gradients,
-                                                         const std::vector<double>& q) const
+                                                         DoubleView gradients,
+                                                         DoubleView q) const
 {
   std::vector<double> gradient;
   backpropConfigurations(current, body, vertices, gradients, q, gradient);
@@ -72,7 +72,7 @@ std::vector<double> SceneQueries::backpropConfigurations(const SceneState& curre
 
 Eigen::VectorXd SceneQueries::backprop(const SceneState& current, const std::string& body_name,
                                        const std::vector<std::uint32_t>& vertices,
-                                       const std::vector<double>& gradients, const std::vector<double>& q) const
+                                       DoubleView gradients, DoubleView q) const
 {
   // One configuration only: backpropConfigurations takes several. (The body
   // is looked up there; an unknown one is checked against 6 values here.)

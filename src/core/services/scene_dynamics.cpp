@@ -57,8 +57,8 @@ std::string singularReason(const BodyModel& body, const double* x, int coordinat
 }  // namespace
 
 void SceneQueries::inverseDynamics(const SceneState& current, const std::vector<std::string>& names,
-                                   const std::vector<double>& q, const std::vector<double>& qdot,
-                                   const std::vector<double>& qddot, bool coriolis, bool derivatives,
+                                   DoubleView q, DoubleView qdot,
+                                   DoubleView qddot, bool coriolis, bool derivatives,
                                    InverseDynamicsAnswer& answer) const
 {
   thread_local std::vector<std::size_t> indices;
@@ -98,8 +98,8 @@ void SceneQueries::inverseDynamics(const SceneState& current, const std::vector<
 }
 
 void SceneQueries::forwardDynamics(const SceneState& current, const std::vector<std::string>& names,
-                                   const std::vector<double>& q, const std::vector<double>& qdot,
-                                   const std::vector<double>& tau, bool derivatives,
+                                   DoubleView q, DoubleView qdot,
+                                   DoubleView tau, bool derivatives,
                                    ForwardDynamicsAnswer& answer) const
 {
   thread_local std::vector<std::size_t> indices;

@@ -115,8 +115,8 @@ void writeStaticFrame(const Eigen::Isometry3d& pose, std::size_t d, double* pose
 }  // namespace
 
 void SceneQueries::frameJacobians(const SceneState& current, const std::string& body_name,
-                                  const std::vector<std::string>& frames, const std::vector<double>& q,
-                                  const std::vector<double>& qdot, std::uint32_t reference, bool acceleration_bias,
+                                  const std::vector<std::string>& frames, DoubleView q,
+                                  DoubleView qdot, std::uint32_t reference, bool acceleration_bias,
                                   FrameJacobianAnswer& answer) const
 {
   const std::size_t index = bodyIndex(body_name, "body");
@@ -172,7 +172,7 @@ void SceneQueries::frameJacobians(const SceneState& current, const std::string& 
 }
 
 void SceneQueries::centerOfMass(const SceneState& current, const std::vector<std::string>& names,
-                                const std::vector<double>& q, const std::vector<double>& qdot, bool jacobians,
+                                DoubleView q, DoubleView qdot, bool jacobians,
                                 CenterOfMassAnswer& answer) const
 {
   thread_local std::vector<std::size_t> indices;

@@ -16,7 +16,7 @@ using detail::reject;
 using detail::sizeMismatch;
 
 void SceneQueries::massMatrices(const SceneState& current, const std::vector<std::string>& names,
-                                const std::vector<double>& q, bool derivatives, MassMatrixAnswer& answer) const
+                                DoubleView q, bool derivatives, MassMatrixAnswer& answer) const
 {
   thread_local std::vector<std::size_t> indices;  // reused: no allocation per call in steady state
   bodyIndices(names, "bodies", indices);
@@ -81,7 +81,7 @@ void SceneQueries::massMatrices(const SceneState& current, const std::vector<std
 }
 
 MassMatrixAnswer SceneQueries::massMatrices(const SceneState& current, const std::vector<std::string>& names,
-                                            const std::vector<double>& q, bool derivatives) const
+                                            DoubleView q, bool derivatives) const
 {
   MassMatrixAnswer answer;
   massMatrices(current, names, q, derivatives, answer);

@@ -119,7 +119,7 @@ std::size_t SceneQueries::checkVertices(std::size_t index, const std::vector<std
   return count;
 }
 
-std::size_t SceneQueries::configurationCount(const std::vector<double>& q, std::size_t index,
+std::size_t SceneQueries::configurationCount(DoubleView q, std::size_t index,
                                              std::size_t vertex_count, std::size_t width) const
 {
   const std::size_t dofs = this->dofs(index);
@@ -152,14 +152,14 @@ std::size_t SceneQueries::configurationCount(const std::vector<double>& q, std::
   return configurations;
 }
 
-const double* SceneQueries::configurationQ(const SceneState& current, std::size_t index, const std::vector<double>& q,
+const double* SceneQueries::configurationQ(const SceneState& current, std::size_t index, DoubleView q,
                                            std::size_t k) const
 {
   return q.empty() ? current[index].data() : q.data() + dofs(index) * k;
 }
 
 void SceneQueries::checkOutputsFit(const SceneState& current, std::size_t index, const JacobianColumns& columns,
-                                   const std::vector<std::uint32_t>& vertices, const std::vector<double>& q,
+                                   const std::vector<std::uint32_t>& vertices, DoubleView q,
                                    std::size_t configurations, double limit, const char* suffix) const
 {
   BodyWorkspace<double>& ws = workspace(index);
@@ -171,7 +171,7 @@ void SceneQueries::checkOutputsFit(const SceneState& current, std::size_t index,
 
 template <typename Out>
 void SceneQueries::vertexQuery(const SceneState& current, const std::string& body_name,
-                               const std::vector<std::uint32_t>& vertices, const std::vector<double>& q, bool compact,
+                               const std::vector<std::uint32_t>& vertices, DoubleView q, bool compact,
                                bool positions_only, std::vector<Out>& positions, std::vector<Out>& jacobians) const
 {
   const std::size_t index = bodyIndex(body_name, "body");
@@ -192,7 +192,7 @@ void SceneQueries::vertexQuery(const SceneState& current, const std::string& bod
 }
 
 void SceneQueries::vertexJacobians(const SceneState& current, const std::string& body_name,
-                                   const std::vector<std::uint32_t>& vertices, const std::vector<double>& q,
+                                   const std::vector<std::uint32_t>& vertices, DoubleView q,
                                    std::vector<double>& positions, std::vector<double>& jacobians) const
 {
   vertexQuery<double>(current, body_name, vertices, q, /*compact=*/false, /*positions_only=*/false, positions,
@@ -201,7 +201,7 @@ void SceneQueries::vertexJacobians(const SceneState& current, const std::string&
 
 template <typename Out>
 void SceneQueries::vertexRotationJacobians(const SceneState& current, const std::string& body_name,
-                                           const std::vector<std::uint32_t>& vertices, const std::vector<double>& q,
+                                           const std::vector<std::uint32_t>& vertices, DoubleView q,
                                            bool positions_only, std::vector<Out>& positions,
                                            std::vector<Out>& rotation_jacobians) const
 {
@@ -209,11 +209,11 @@ void SceneQueries::vertexRotationJacobians(const SceneState& current, const std:
 }
 template void SceneQueries::vertexRotationJacobians<double>(const SceneState&, const std::string&,
                                                             const std::vector<std::uint32_t>&,
-                                                            const std::vector<double>&, bool, std::vector<double>&,
+                                                            DoubleView, bool, std::vector<double>&,
                                                             std::vector<double>&) const;
 template void SceneQueries::vertexRotationJacobians<float>(const SceneState&, const std::string&,
                                                            const std::vector<std::uint32_t>&,
-                                                           const std::vector<double>&, bool, std::vector<float>&,
+                                                           DoubleView, bool, std::vector<float>&,
                                                            std::vector<float>&) const;
 
 }  // namespace diff_rigid_body
