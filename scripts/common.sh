@@ -31,8 +31,8 @@ DRB_APT_PACKAGES=(
   libeigen3-dev libassimp-dev libtinyxml2-dev
   libmpfrc++-dev libmpfr-dev libgmp-dev liborocos-kdl-dev libkdl-parser-dev libmujoco-dev libbenchmark-dev
   python3-numpy python3-yaml python3-scipy
-  # diff_rigid_body._local: the core in process (pybind11; LocalScene)
-  pybind11-dev python3-pybind11
+  # diff_rigid_body._local: the core in process (pybind11; LocalScene); batches over Dask (dask_batches)
+  pybind11-dev python3-pybind11 python3-distributed
   # diff_rigid_body.torch, its rostest, the trajectory demo and bench/client_trajectory.py
   python3-torch
   # joint_states (sensor_msgs/JointState); demo.launch joint_state_publisher:=true|gui

@@ -12,6 +12,15 @@ the example optimisers run by ``nodes/demo_client.py``.
 The generated ``diff_rigid_body.msg`` and ``diff_rigid_body.srv`` packages sit
 beside these modules (catkin merges them).
 """
+from pkgutil import extend_path as _extend_path
+
+# The compiled diff_rigid_body._local and the generated msg and srv lie in the devel (or install)
+# space's diff_rigid_body folder. A process started with its parent's sys.path (Dask's worker
+# processes) finds this source folder first: the folders of the same name further on sys.path join
+# the package here (as catkin's devel-space __init__ does).
+__path__ = _extend_path(__path__, __name__)
+del _extend_path
+
 # Imported lazily so that ``import diff_rigid_body.msg`` does not need rospy's
 # service machinery or numpy.
 
