@@ -5,7 +5,7 @@ the Panda, the UR5 (a gravity of its own), simple_humanoid with a floating base 
 scene of free bodies. Also: refusals raise DiffRigidBodyError with the node's message; an answer's
 arrays are views of the buffer the core filled (their base is the module's capsule, not a numpy
 copy); float64 inputs reach the core as the caller's buffers; threads calling one scene at once get
-the answers of serial calls.
+the answers of serial calls; the PyTorch functions give the node's values and gradients over it.
 """
 import concurrent.futures
 import sys
@@ -195,6 +195,32 @@ class LocalSceneAgainstNode(unittest.TestCase):
                 concurrent_answers = list(pool.map(work, inputs))
                 for i, (a, b) in enumerate(zip(concurrent_answers, serial)):
                     assert_same(self, a, b, 'item %d' % i)
+
+    def test_i_torch_functions_take_either_backend(self):
+        """diff_rigid_body.torch and torch_frames over a LocalScene: the node's values and gradients."""
+        import torch
+        from diff_rigid_body import torch as drb_torch
+        from diff_rigid_body import torch_frames
+        local, node, bodies = self.pairs['panda']
+        body, count = bodies.names[0], int(bodies.vertex_counts[0])
+        frame = bodies.links[0][-1].name
+        x = self.configurations(bodies)
+        losses = (
+            lambda c, q: drb_torch.vertex_positions(c, body, q, vertices=list(range(0, count, 7))).sum(),
+            lambda c, q: drb_torch.kinetic_energy(c, body, q, q.detach() + 0.5).sum(),
+            lambda c, q: drb_torch.inverse_dynamics(c, q, q * 0.5, q * 0.25, body).sum(),
+            lambda c, q: drb_torch.forward_dynamics(c, q, q * 0.5, q * 0.25, body).sum(),
+            lambda c, q: sum(part.sum() for part in torch_frames.frame_pose(c, body, frame, q)),
+            lambda c, q: torch_frames.center_of_mass(c, body, q).sum(),
+        )
+        for i, loss in enumerate(losses):
+            answers = []
+            for backend in (local, node):
+                q = torch.tensor(x, requires_grad=True)
+                value = loss(backend, q)
+                value.backward()
+                answers.append((value.detach().numpy(), q.grad.numpy()))
+            assert_same(self, answers[0], answers[1], 'torch loss %d' % i)
 
     def test_h_load_refusals(self):
         with self.assertRaises(DiffRigidBodyError) as refusal:
