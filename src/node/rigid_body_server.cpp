@@ -199,25 +199,9 @@ void RigidBodyServer::publishStaticLinks()
 
 bool RigidBodyServer::getBodies(GetBodies::Request&, GetBodies::Response& response)
 {
-  return serve(response, "get_bodies", [&] {
-    BodiesAnswer answer = describeBodies(queries_.scene());
-    response.fixed_frame = frame_prefix_ + answer.fixed_frame;
-    response.names = std::move(answer.names);
-    response.masses = std::move(answer.masses);
-    response.inertias = std::move(answer.inertias);
-    response.com_offsets = std::move(answer.com_offsets);
-    response.vertex_counts = std::move(answer.vertex_counts);
-    response.dofs = std::move(answer.dofs);
-    response.joint_names = std::move(answer.joint_names);
-    response.joint_counts = std::move(answer.joint_counts);
-    response.joint_lower = std::move(answer.joint_lower);
-    response.joint_upper = std::move(answer.joint_upper);
-    response.link_names = std::move(answer.link_names);
-    response.link_counts = std::move(answer.link_counts);
-    response.link_vertex_counts = std::move(answer.link_vertex_counts);
-    response.link_masses = std::move(answer.link_masses);
-    response.link_inertias = std::move(answer.link_inertias);
-    response.link_com_offsets = std::move(answer.link_com_offsets);
+  return serveAnswer<BodiesAnswer>(response, "get_bodies", [&](BodiesAnswer& answer) {
+    answer = describeBodies(queries_.scene());
+    answer.fixed_frame = frame_prefix_ + answer.fixed_frame;
   });
 }
 

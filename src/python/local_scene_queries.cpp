@@ -1,6 +1,6 @@
 // LocalScene's queries: each calls the SceneQueries member that the node's handler of the same
 // service calls (src/node/rigid_body_server.cpp), with the GIL released, and moves the answer's
-// arrays into numpy (adopt) under the response's field names.
+// arrays into numpy (adopt) under the response's field names (the answer's field list).
 #include <optional>
 
 #include <pybind11/stl.h>
@@ -42,30 +42,37 @@ Values<double> requiredQ(const InputArray<double>& q, const char* service)
     throw Refusal{ service, "q: required: a local scene has no state (give K configurations, K >= 1)" };
   return Values<double>(q);
 }
+
+// A response field as Python: numeric vectors handed to numpy (adopt), names as a list, scalars.
+template <typename T>
+py::object toPython(std::vector<T>&& values)
+{
+  return adopt(std::move(values));
+}
+py::object toPython(std::vector<std::string>&& names)
+{
+  return py::cast(names);
+}
+py::object toPython(std::string&& text)
+{
+  return py::str(text);
+}
+py::object toPython(std::uint32_t value)
+{
+  return py::int_(value);
+}
 }  // namespace
+
+// One dict entry per field of an answer's field list (scene_queries.h, bodies_answer.h), under the
+// response field's name; used with `answer` and the dict `r` in scope.
+#define DRB_PYTHON_FIELD(type, name) r[#name] = toPython(std::move(answer.name));
 
 py::dict LocalScene::getBodies() const
 {
   BodiesAnswer answer;
   serve("get_bodies", [&] { answer = describeBodies(queries_->scene()); });
   py::dict r;
-  r["fixed_frame"] = answer.fixed_frame;
-  r["names"] = answer.names;
-  r["masses"] = adopt(std::move(answer.masses));
-  r["inertias"] = adopt(std::move(answer.inertias));
-  r["com_offsets"] = adopt(std::move(answer.com_offsets));
-  r["vertex_counts"] = adopt(std::move(answer.vertex_counts));
-  r["dofs"] = adopt(std::move(answer.dofs));
-  r["joint_names"] = answer.joint_names;
-  r["joint_counts"] = adopt(std::move(answer.joint_counts));
-  r["joint_lower"] = adopt(std::move(answer.joint_lower));
-  r["joint_upper"] = adopt(std::move(answer.joint_upper));
-  r["link_names"] = answer.link_names;
-  r["link_counts"] = adopt(std::move(answer.link_counts));
-  r["link_vertex_counts"] = adopt(std::move(answer.link_vertex_counts));
-  r["link_masses"] = adopt(std::move(answer.link_masses));
-  r["link_inertias"] = adopt(std::move(answer.link_inertias));
-  r["link_com_offsets"] = adopt(std::move(answer.link_com_offsets));
+  DRB_BODIES_ANSWER_FIELDS(DRB_PYTHON_FIELD)
   return r;
 }
 
@@ -76,11 +83,7 @@ py::dict LocalScene::getMassMatrix(const std::vector<std::string>& bodies, const
   MassMatrixAnswer answer;
   serve("get_mass_matrix", [&] { queries_->massMatrices(state_, bodies, x.view(), derivatives, answer); });
   py::dict r;
-  r["bodies"] = answer.bodies;
-  r["dofs"] = adopt(std::move(answer.dofs));
-  r["mass_matrices"] = adopt(std::move(answer.mass_matrices));
-  r["derivatives"] = adopt(std::move(answer.derivatives));
-  r["cos_theta"] = adopt(std::move(answer.cos_theta));
+  DRB_MASS_MATRIX_ANSWER_FIELDS(DRB_PYTHON_FIELD)
   return r;
 }
 
@@ -152,15 +155,7 @@ py::dict LocalScene::inverseDynamics(const std::vector<std::string>& bodies, con
                               answer);
   });
   py::dict r;
-  r["bodies"] = answer.bodies;
-  r["dofs"] = adopt(std::move(answer.dofs));
-  r["tau"] = adopt(std::move(answer.tau));
-  r["velocity_terms"] = adopt(std::move(answer.velocity_terms));
-  r["gravity_terms"] = adopt(std::move(answer.gravity_terms));
-  r["coriolis_matrices"] = adopt(std::move(answer.coriolis_matrices));
-  r["dtau_dq"] = adopt(std::move(answer.dtau_dq));
-  r["dtau_dqdot"] = adopt(std::move(answer.dtau_dqdot));
-  r["cos_theta"] = adopt(std::move(answer.cos_theta));
+  DRB_INVERSE_DYNAMICS_ANSWER_FIELDS(DRB_PYTHON_FIELD)
   return r;
 }
 
@@ -174,13 +169,7 @@ py::dict LocalScene::forwardDynamics(const std::vector<std::string>& bodies, con
     queries_->forwardDynamics(state_, bodies, x.view(), v.view(), t.view(), derivatives, answer);
   });
   py::dict r;
-  r["bodies"] = answer.bodies;
-  r["dofs"] = adopt(std::move(answer.dofs));
-  r["qddot"] = adopt(std::move(answer.qddot));
-  r["dqddot_dq"] = adopt(std::move(answer.dqddot_dq));
-  r["dqddot_dqdot"] = adopt(std::move(answer.dqddot_dqdot));
-  r["dqddot_dtau"] = adopt(std::move(answer.dqddot_dtau));
-  r["cos_theta"] = adopt(std::move(answer.cos_theta));
+  DRB_FORWARD_DYNAMICS_ANSWER_FIELDS(DRB_PYTHON_FIELD)
   return r;
 }
 
@@ -194,12 +183,7 @@ py::dict LocalScene::getFrameJacobians(const std::string& body, const std::vecto
     queries_->frameJacobians(state_, body, frames, x.view(), v.view(), reference, acceleration_bias, answer);
   });
   py::dict r;
-  r["frames"] = answer.frames;
-  r["dofs"] = answer.dofs;
-  r["poses"] = adopt(std::move(answer.poses));
-  r["jacobians"] = adopt(std::move(answer.jacobians));
-  r["acceleration_bias"] = adopt(std::move(answer.acceleration_bias));
-  r["cos_theta"] = adopt(std::move(answer.cos_theta));
+  DRB_FRAME_JACOBIAN_ANSWER_FIELDS(DRB_PYTHON_FIELD)
   return r;
 }
 
@@ -211,13 +195,7 @@ py::dict LocalScene::getCenterOfMass(const std::vector<std::string>& bodies, con
   serve("get_center_of_mass",
         [&] { queries_->centerOfMass(state_, bodies, x.view(), v.view(), jacobians, answer); });
   py::dict r;
-  r["bodies"] = answer.bodies;
-  r["dofs"] = adopt(std::move(answer.dofs));
-  r["masses"] = adopt(std::move(answer.masses));
-  r["com"] = adopt(std::move(answer.com));
-  r["jacobians"] = adopt(std::move(answer.jacobians));
-  r["acceleration_bias"] = adopt(std::move(answer.acceleration_bias));
-  r["cos_theta"] = adopt(std::move(answer.cos_theta));
+  DRB_CENTER_OF_MASS_ANSWER_FIELDS(DRB_PYTHON_FIELD)
   return r;
 }
 

@@ -9,30 +9,42 @@
 #include <vector>
 
 #include "diff_rigid_body/parsers/urdf_scene.h"
+#include "diff_rigid_body/services/scene_queries.h"
 
 namespace diff_rigid_body
 {
 /// Per body (n of them), then per joint coordinate and per link, flattened in
-/// scene order. Matrices are row-major; units [kg], [kg m^2], [m], [rad or m].
+/// scene order, named as in srv/GetBodies.srv. Matrices are row-major; units
+/// [kg], [kg m^2], [m], [rad or m]. fixed_frame: without any frame prefix;
+/// names: each body's root link; masses: the total of its links; inertias (9
+/// per body): the root link's group about its COM, root link axes;
+/// com_offsets (3 per body): that group's COM in the root link frame; dofs:
+/// d = len(x); joint_names: the joints of x, body after body, with
+/// joint_counts per body and their limits (+-inf where none); link_names:
+/// body after body in vertex order, with link_counts per body and per link its
+/// vertices, mass, inertia about its COM in link axes (9) and COM in its own
+/// frame (3).
+#define DRB_BODIES_ANSWER_FIELDS(X)                                                                                    \
+  X(std::string, fixed_frame)                                                                                          \
+  X(std::vector<std::string>, names)                                                                                   \
+  X(std::vector<double>, masses)                                                                                       \
+  X(std::vector<double>, inertias)                                                                                     \
+  X(std::vector<double>, com_offsets)                                                                                  \
+  X(std::vector<std::uint32_t>, vertex_counts)                                                                         \
+  X(std::vector<std::uint32_t>, dofs)                                                                                  \
+  X(std::vector<std::string>, joint_names)                                                                             \
+  X(std::vector<std::uint32_t>, joint_counts)                                                                          \
+  X(std::vector<double>, joint_lower)                                                                                  \
+  X(std::vector<double>, joint_upper)                                                                                  \
+  X(std::vector<std::string>, link_names)                                                                              \
+  X(std::vector<std::uint32_t>, link_counts)                                                                           \
+  X(std::vector<std::uint32_t>, link_vertex_counts)                                                                    \
+  X(std::vector<double>, link_masses)                                                                                  \
+  X(std::vector<double>, link_inertias)                                                                                \
+  X(std::vector<double>, link_com_offsets)
 struct BodiesAnswer
 {
-  std::string fixed_frame;               ///< without any frame prefix
-  std::vector<std::string> names;        ///< per body: its root link
-  std::vector<double> masses;            ///< per body: the total of its links
-  std::vector<double> inertias;          ///< 9 per body: the root link's group about its COM, root link axes
-  std::vector<double> com_offsets;       ///< 3 per body: that group's COM in the root link frame
-  std::vector<std::uint32_t> vertex_counts;
-  std::vector<std::uint32_t> dofs;       ///< per body: d = len(x)
-  std::vector<std::string> joint_names;  ///< the joints of x, body after body
-  std::vector<std::uint32_t> joint_counts;
-  std::vector<double> joint_lower;       ///< per joint: -inf where none
-  std::vector<double> joint_upper;       ///< per joint: +inf where none
-  std::vector<std::string> link_names;   ///< body after body, in vertex order
-  std::vector<std::uint32_t> link_counts;
-  std::vector<std::uint32_t> link_vertex_counts;
-  std::vector<double> link_masses;
-  std::vector<double> link_inertias;     ///< 9 per link: about its COM, link axes
-  std::vector<double> link_com_offsets;  ///< 3 per link: its COM in its own frame
+  DRB_ANSWER(DRB_BODIES_ANSWER_FIELDS)
 };
 
 /// The answer for every body of `scene`.
