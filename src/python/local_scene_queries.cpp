@@ -106,26 +106,21 @@ py::dict LocalScene::getVertexJacobiansCompact(const std::string& body, const In
                                                bool single_precision) const
 {
   const Values<double> x = requiredQ(q, "get_vertex_jacobians_compact");
-  const Values<std::uint32_t> selected(vertices);
+  const std::vector<std::uint32_t> selected = Values<std::uint32_t>(vertices).vector();
   py::dict r;
-  if (single_precision)
-  {
-    std::vector<float> positions, jacobians;
+  // Out: float for the float32 transport's fields (*_f32), else double.
+  const auto answer = [&](auto out, const char* positions_field, const char* jacobians_field) {
+    std::vector<decltype(out)> positions, jacobians;
     serve("get_vertex_jacobians_compact", [&] {
-      queries_->vertexRotationJacobians(state_, body, selected.vector(), x.view(), positions_only, positions,
-                                        jacobians);
+      queries_->vertexRotationJacobians(state_, body, selected, x.view(), positions_only, positions, jacobians);
     });
-    r["positions_f32"] = adopt(std::move(positions));
-    r["rotation_jacobians_f32"] = adopt(std::move(jacobians));
-    return r;
-  }
-  std::vector<double> positions, jacobians;
-  serve("get_vertex_jacobians_compact", [&] {
-    queries_->vertexRotationJacobians(state_, body, selected.vector(), x.view(), positions_only, positions,
-                                      jacobians);
-  });
-  r["positions"] = adopt(std::move(positions));
-  r["rotation_jacobians"] = adopt(std::move(jacobians));
+    r[positions_field] = adopt(std::move(positions));
+    r[jacobians_field] = adopt(std::move(jacobians));
+  };
+  if (single_precision)
+    answer(0.0f, "positions_f32", "rotation_jacobians_f32");
+  else
+    answer(0.0, "positions", "rotation_jacobians");
   return r;
 }
 

@@ -16,20 +16,9 @@ import rostest
 
 from diff_rigid_body import LocalScene
 from diff_rigid_body.dask_batches import SceneDescription, map_configurations, shard_bounds
+from local_scene_check import assert_same
 
 rng = np.random.RandomState(30)
-
-
-def assert_same(test, a, b, where):
-    if isinstance(b, tuple) or isinstance(b, list):
-        test.assertEqual(len(a), len(b), where)
-        for i, (x, y) in enumerate(zip(a, b)):
-            assert_same(test, x, y, '%s[%d]' % (where, i))
-    elif b is None or isinstance(b, (str, float, int)):
-        test.assertEqual(a, b, where)
-    else:
-        test.assertEqual((a.shape, a.dtype), (b.shape, b.dtype), where)
-        test.assertTrue(np.array_equal(a, b), '%s: not the same bits' % where)
 
 
 def kill_first_shard(marker):
