@@ -17,6 +17,7 @@ import rostest
 
 from diff_rigid_body import LocalScene, _local
 from diff_rigid_body.client import DiffRigidBodyError, RigidBodyClient
+from diff_rigid_body.local import LOCAL_SERVICES
 
 WAIT = 60.0
 K = 5
@@ -70,6 +71,10 @@ class LocalSceneAgainstNode(unittest.TestCase):
         """K random x of the bodies ``names`` (None = all) concatenated: (K, D)."""
         dofs = [int(d) for n, d in zip(bodies.names, bodies.dofs) if names is None or n in names]
         return rng.uniform(-1.0, 1.0, (K, sum(dofs))) * 0.8
+
+    def test_a_every_state_free_service(self):
+        """LocalScene answers every service of the client but the two about the node's state."""
+        self.assertEqual(set(LOCAL_SERVICES), set(RigidBodyClient.SERVICES) - {'get_state', 'set_state'})
 
     def test_a_bodies(self):
         for name, (local, node, bodies) in self.pairs.items():
