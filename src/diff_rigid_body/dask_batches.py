@@ -29,6 +29,10 @@ __all__ = ['SceneDescription', 'map_configurations', 'compute_shard', 'PER_CONFI
 
 #: Keyword arguments cut along K with q.
 PER_CONFIGURATION = ('q', 'qdot', 'qddot', 'tau', 'gradients')
+#: Most configurations in one shard by default: keeps each shard's answer within the core's request
+#: limits (RequestLimits) and its transfer small, e.g. 1000 x 3711 doubles (30 MB) of forward
+#: dynamics with derivatives of a 35-dof humanoid.
+SHARD_CONFIGURATIONS = 1000
 #: Answer fields that are per body or per frame, the same in every shard (taken from the first).
 SHARED_FIELDS = ('bodies', 'frames', 'masses')
 
@@ -82,13 +86,14 @@ def join(parts, field=None):
 def map_configurations(client, description, method, shards=None, **arguments):
     """``LocalScene.<method>(**arguments)`` for K configurations (``q`` of shape (K, ...)),
     computed in shards on the workers of ``client`` (a ``distributed.Client``): by default two
-    per worker thread. Returns what the method returns for all K at once, bit for bit. A refusal
-    raises DiffRigidBodyError (that of the first refused shard)."""
+    per worker thread, and more if needed to keep each to SHARD_CONFIGURATIONS. Returns what the
+    method returns for all K at once, bit for bit. A refusal raises DiffRigidBodyError (that of
+    the first refused shard)."""
     q = np.asarray(arguments['q'])
     if q.ndim < 2 or q.shape[0] == 0:
         raise ValueError('q: K configurations along the first axis, got shape %s' % (q.shape,))
     if shards is None:
-        shards = 2 * max(1, sum(client.nthreads().values()))
+        shards = max(2 * max(1, sum(client.nthreads().values())), -(-q.shape[0] // SHARD_CONFIGURATIONS))
     # In a list (scatter would split a tuple); hash=False: a key of its own, which an earlier call's
     # released copy of the same description cannot take away while this call runs.
     scattered = client.scatter([description], broadcast=True, hash=False)[0]
