@@ -77,6 +77,27 @@ inline std::size_t dynamicsConfigurations(const detail::RequestLayout& layout, s
   return configurations;
 }
 
+/// The bodies of a multi-body batched request (get_mass_matrix's layout):
+/// their scene indices (this thread's buffer, valid until its next request),
+/// where each one's values sit, and K.
+struct BatchedBodies
+{
+  const std::vector<std::size_t>& indices;
+  const RequestLayout& layout;
+  std::size_t K;
+};
+
+/// Resolves `names` (empty = all; unknown ones refused by name), lays them
+/// out, and checks q and `others` as dynamicsConfigurations.
+inline BatchedBodies batchedBodies(const SceneQueries& queries, const std::vector<std::string>& names, DoubleView q,
+                                   std::initializer_list<std::pair<const char*, const DoubleView*>> others)
+{
+  thread_local std::vector<std::size_t> indices;
+  queries.bodyIndices(names, "bodies", indices);
+  const RequestLayout& layout = requestLayout(queries, indices);
+  return { indices, layout, dynamicsConfigurations(layout, indices.size(), q, others) };
+}
+
 /// Refuses an answer of more doubles than the budget of get_mass_matrix
 /// (with matrices: its budget with derivatives).
 inline void checkDynamicsBudget(std::size_t configurations, std::size_t per_configuration, bool matrices)

@@ -13,7 +13,6 @@
 namespace diff_rigid_body
 {
 using detail::checkDynamicsBudget;
-using detail::dynamicsConfigurations;
 using detail::forEachBodySlot;
 using detail::reject;
 using detail::requireFiniteResults;
@@ -61,11 +60,11 @@ void SceneQueries::inverseDynamics(const SceneState& current, const std::vector<
                                    DoubleView qddot, bool coriolis, bool derivatives,
                                    InverseDynamicsAnswer& answer) const
 {
-  thread_local std::vector<std::size_t> indices;
-  bodyIndices(names, "bodies", indices);
-  const detail::RequestLayout& layout = detail::requestLayout(*this, indices);
-  const std::size_t n = indices.size();
-  const std::size_t K = dynamicsConfigurations(layout, n, q, { { "qdot", &qdot }, { "qddot", &qddot } });
+  const detail::BatchedBodies batch =
+      detail::batchedBodies(*this, names, q, { { "qdot", &qdot }, { "qddot", &qddot } });
+  const std::vector<std::size_t>& indices = batch.indices;
+  const detail::RequestLayout& layout = batch.layout;
+  const std::size_t K = batch.K, n = indices.size();
   const std::size_t matrices = (coriolis ? 1 : 0) + (derivatives ? 2 : 0);
   checkDynamicsBudget(K, 3 * layout.D + matrices * layout.per_m + n, matrices > 0);
   setBodies(*this, indices, answer);
@@ -102,11 +101,10 @@ void SceneQueries::forwardDynamics(const SceneState& current, const std::vector<
                                    DoubleView tau, bool derivatives,
                                    ForwardDynamicsAnswer& answer) const
 {
-  thread_local std::vector<std::size_t> indices;
-  bodyIndices(names, "bodies", indices);
-  const detail::RequestLayout& layout = detail::requestLayout(*this, indices);
-  const std::size_t n = indices.size();
-  const std::size_t K = dynamicsConfigurations(layout, n, q, { { "qdot", &qdot }, { "tau", &tau } });
+  const detail::BatchedBodies batch = detail::batchedBodies(*this, names, q, { { "qdot", &qdot }, { "tau", &tau } });
+  const std::vector<std::size_t>& indices = batch.indices;
+  const detail::RequestLayout& layout = batch.layout;
+  const std::size_t K = batch.K, n = indices.size();
   checkDynamicsBudget(K, layout.D + (derivatives ? 3 * layout.per_m : 0) + n, derivatives);
   setBodies(*this, indices, answer);
   answer.qddot.resize(K * layout.D);

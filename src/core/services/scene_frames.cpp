@@ -175,11 +175,10 @@ void SceneQueries::centerOfMass(const SceneState& current, const std::vector<std
                                 DoubleView q, DoubleView qdot, bool jacobians,
                                 CenterOfMassAnswer& answer) const
 {
-  thread_local std::vector<std::size_t> indices;
-  bodyIndices(names, "bodies", indices);
-  const detail::RequestLayout& layout = detail::requestLayout(*this, indices);
-  const std::size_t n = indices.size();
-  const std::size_t K = dynamicsConfigurations(layout, n, q, { { "qdot", &qdot } });
+  const detail::BatchedBodies batch = detail::batchedBodies(*this, names, q, { { "qdot", &qdot } });
+  const std::vector<std::size_t>& indices = batch.indices;
+  const detail::RequestLayout& layout = batch.layout;
+  const std::size_t K = batch.K, n = indices.size();
   checkDynamicsBudget(K, 4 * n + (jacobians ? 3 * layout.D + 3 * n : 0), jacobians);
   for (std::size_t i = 0; i < n; ++i)
     if (!(scene_.bodies[indices[i]].mass() > 0.0))
