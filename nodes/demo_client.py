@@ -19,7 +19,13 @@ a second one serving urdf/t_handle.urdf (namespace t_handle).
    gradients; the flip time is reported with its standard deviation.
 
 Usage: demo_client.py [--body knot] [--noise 0.001] [--configurations 1000] [--frames 60]
-                      [--t-handle-server /t_handle/rigid_body_server] [--drop-dqddot-dq]
+                      [--t-handle-server /t_handle/rigid_body_server] [--backend node|local]
+                      [--drop-dqddot-dq]
+
+--backend local runs example 3 (the T-handle's dynamics and trajectory fits)
+in this process on diff_rigid_body.LocalScene, loaded from urdf/t_handle.urdf
+with the node's defaults, instead of through the t_handle node: the same
+client calls, the node's numbers bit for bit.
 
 Exits 1 unless every fit converged: without noise each pose fit must recover
 the hidden pose to EXACT_ANGLE [rad] and EXACT_POSITION [m]; with noise the
@@ -36,8 +42,10 @@ import sys
 import time
 
 import numpy as np
+import rospkg
 import rospy
 
+from diff_rigid_body import LocalScene
 from diff_rigid_body.client import DiffRigidBodyError, RigidBodyClient
 from diff_rigid_body import dynamics_fitting, pose_fitting, t_handle, trajectory_energy, trajectory_fitting
 
@@ -129,7 +137,8 @@ def t_handle_example(client, noise, frames, drop_dqddot_dq=False):
     vertices = np.arange(0, bodies.vertex_counts[i], 4).astype(np.uint32)
     gravity = np.asarray(client.forward_dynamics(x_hidden[None, None, :6], bodies=[T_HANDLE]).qddot).reshape(6)[3:]
     print('\n3. A tossed T-handle (%s, body %r): %.5f kg, I_b diagonal (%s) kg m^2, %d vertices' % (
-        client.server, T_HANDLE, bodies.masses[i], ', '.join('%.3e' % v for v in np.diag(inertia)),
+        getattr(client, 'server', 'in process, LocalScene'), T_HANDLE, bodies.masses[i],
+        ', '.join('%.3e' % v for v in np.diag(inertia)),
         bodies.vertex_counts[i]))
     print('   spun at %.1f rad/s about its intermediate axis (z, the grip), tossed at %.1f m/s; gravity (from '
           'forward_dynamics at rest) (%s) m/s^2' % (np.linalg.norm(t_handle.SPIN), np.linalg.norm(x_hidden[9:]),
@@ -241,6 +250,9 @@ def main():
                         help='T of the T-handle fit, frames of 0.02 s (default: %d)' % t_handle.FRAMES)
     parser.add_argument('--t-handle-server', default='/t_handle/rigid_body_server',
                         help='the node serving urdf/t_handle.urdf (default: /t_handle/rigid_body_server)')
+    parser.add_argument('--backend', choices=('node', 'local'), default='node',
+                        help="example 3 through the t_handle node ('node', default) or in process on a LocalScene "
+                             "of urdf/t_handle.urdf ('local')")
     parser.add_argument('--drop-dqddot-dq', action='store_true',
                         help="a wrong gradient: leave dx''/dx out of the T-handle's sensitivities (the demo must fail)")
     args = parser.parse_args(rospy.myargv()[1:])
@@ -250,8 +262,11 @@ def main():
     bodies = print_scene(client)
     failures = pose_fitting_example(client, args.body, [0.0, args.noise])
     trajectory_example(client, bodies, args.configurations)
-    failures += t_handle_example(RigidBodyClient(args.t_handle_server).connect(), args.noise, args.frames,
-                                 args.drop_dqddot_dq)
+    if args.backend == 'local':
+        t_handle_scene = LocalScene(urdf_path=rospkg.RosPack().get_path('diff_rigid_body') + '/urdf/t_handle.urdf')
+    else:
+        t_handle_scene = RigidBodyClient(args.t_handle_server).connect()
+    failures += t_handle_example(t_handle_scene, args.noise, args.frames, args.drop_dqddot_dq)
     try:
         client.vertex_jacobians('no_such_body')
     except DiffRigidBodyError as e:
