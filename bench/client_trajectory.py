@@ -2,7 +2,7 @@
 """Client benchmark: a trajectory loss and its gradient through PyTorch.
 
 L(x) = 1/2 sum_k,v |p_v(q(t_k)) - o_kv|^2 over T frames of 64 knot vertices,
-q(t) the ballistic trajectory of diff_rigid_body.trajectory_fitting, dL/dx by
+q(t) the ballistic trajectory of diff_rigid_body_examples.trajectory_fitting, dL/dx by
 autograd through diff_rigid_body.torch.vertex_positions: a positions call and
 a backprop call for all T frames (batched) against 2T calls (per frame).
 
@@ -33,7 +33,7 @@ from rospy.numpy_msg import numpy_msg
 
 from diff_rigid_body.client import RigidBodyClient
 from diff_rigid_body import torch as drb_torch
-from diff_rigid_body import trajectory_fitting
+from diff_rigid_body_examples import trajectory_fitting
 from diff_rigid_body.client_arrays import to_wire
 from diff_rigid_body.srv import Echo
 

@@ -11,7 +11,7 @@ a second one serving urdf/t_handle.urdf (namespace t_handle).
    trajectory: one batched get_mass_matrix call against K calls.
 3. A tossed T-handle spun about its intermediate axis (it flips: the
    Dzhanibekov effect), integrated by RK4 through forward_dynamics with the
-   node's gravity (diff_rigid_body.dynamics_fitting). Its sensitivities
+   node's gravity (diff_rigid_body_examples.dynamics_fitting). Its sensitivities
    ds/ds0 (the variational equations, from the served dqddot_dq and
    dqddot_dqdot) are checked against central differences; (q0, q0') (12
    numbers) are recovered from noisy positions of 32 of its vertices at T
@@ -47,12 +47,12 @@ import rospy
 
 from diff_rigid_body import LocalScene
 from diff_rigid_body.client import DiffRigidBodyError, RigidBodyClient
-from diff_rigid_body import dynamics_fitting, pose_fitting, t_handle, trajectory_energy, trajectory_fitting
+from diff_rigid_body_examples import dynamics_fitting, pose_fitting, t_handle, trajectory_energy, trajectory_fitting
 
 Q_HIDDEN = np.array([0.3, -0.4, 1.1, 0.05, -0.1, 0.6])  # the pose to recover
 EXACT_ANGLE, EXACT_POSITION = 1e-8, 1e-8  # [rad], [m]: noise-free fit vs Q_HIDDEN
 AGREE_ANGLE, AGREE_POSITION = 1e-6, 1e-6  # [rad], [m]: noisy fits, one vs the other
-# The T-handle's toss (diff_rigid_body.t_handle): spun about its intermediate axis (z, the grip).
+# The T-handle's toss (diff_rigid_body_examples.t_handle): spun about its intermediate axis (z, the grip).
 T_HANDLE = t_handle.BODY
 FRAME_TIME = t_handle.FRAME_TIME  # [s] between frames, one RK4 step each
 FLIP_SUBSTEPS = 4         # RK4 steps per frame for the flip time

@@ -24,7 +24,7 @@ import numpy as np
 import rospy
 
 from diff_rigid_body.client import DiffRigidBodyError, RigidBodyClient
-from diff_rigid_body.joint_fitting import fit_joints, joint_bounds
+from diff_rigid_body_examples.joint_fitting import fit_joints, joint_bounds
 
 EXACT = 1e-8          # [rad or m] noise-free fit vs x*
 NOISE_SIGMAS = 5.0    # noisy fit: max |x - x*| / standard deviation of the estimate

@@ -6,8 +6,8 @@ persistent service connections) and :class:`DiffRigidBodyError`.
 node's core (``diff_rigid_body._local``), without a node.
 ``diff_rigid_body.pool``: :class:`RigidBodyPool` (the same methods over several
 instances: K configurations sharded, failover) and :class:`PoolError`.
-``diff_rigid_body.pose_fitting`` and ``diff_rigid_body.trajectory_energy``:
-the example optimisers run by ``nodes/demo_client.py``.
+The example optimisers that ``nodes/demo_client.py`` runs are the package
+``diff_rigid_body_examples`` (examples/), beside this one.
 
 The generated ``diff_rigid_body.msg`` and ``diff_rigid_body.srv`` packages sit
 beside these modules (catkin merges them).

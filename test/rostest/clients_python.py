@@ -24,7 +24,7 @@ import rospy
 import rostest
 
 from diff_rigid_body.client import DiffRigidBodyError, RigidBodyClient
-from diff_rigid_body import pose_fitting, trajectory_energy, trajectory_fitting
+from diff_rigid_body_examples import pose_fitting, trajectory_energy, trajectory_fitting
 
 PKG = 'diff_rigid_body'
 SERVER = '/rigid_body_server'

@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """The T-handle's flip in rviz (t_handle_rviz.test): docs/rviz_t_handle.png.
 
-The demo's toss (diff_rigid_body.t_handle) is integrated by RK4 through the
-node's ``forward_dynamics`` (diff_rigid_body.dynamics_fitting.integrate), as
+The demo's toss (diff_rigid_body_examples.t_handle) is integrated by RK4 through the
+node's ``forward_dynamics`` (diff_rigid_body_examples.dynamics_fitting.integrate), as
 nodes/demo_client.py does. A strobe picture of the flight is drawn in rviz
 (headless: this node runs under xvfb-run, rviz uses software OpenGL):
 
@@ -41,7 +41,7 @@ from geometry_msgs.msg import Point
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
-from diff_rigid_body import dynamics_fitting, t_handle
+from diff_rigid_body_examples import dynamics_fitting, t_handle
 from diff_rigid_body import rviz_capture as rc
 from diff_rigid_body.client import RigidBodyClient
 

@@ -32,7 +32,7 @@ import torch
 from torch.autograd.gradcheck import GradcheckError
 
 from diff_rigid_body.client import RigidBodyClient
-from diff_rigid_body import pose_fitting
+from diff_rigid_body_examples import pose_fitting
 from diff_rigid_body import torch as drb_torch
 
 PKG = 'diff_rigid_body'

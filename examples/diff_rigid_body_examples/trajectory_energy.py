@@ -11,7 +11,7 @@ import time
 
 import numpy as np
 
-from diff_rigid_body.pose_fitting import rpy_to_matrix
+from diff_rigid_body_examples.pose_fitting import rpy_to_matrix
 
 __all__ = ['demo_trajectory', 'kinetic_energy', 'energy_batched', 'energy_per_call', 'energy_from_inertia']
 

@@ -11,7 +11,7 @@ and the bar axis (x) stays far from it, so theta stays far from gimbal lock
 """
 import numpy as np
 
-from diff_rigid_body.dynamics_fitting import rpy_rates
+from diff_rigid_body_examples.dynamics_fitting import rpy_rates
 
 __all__ = ['BODY', 'Q0', 'SPIN', 'VELOCITY', 'FRAME_TIME', 'FRAMES', 'INTERMEDIATE_AXIS', 'hidden_toss']
 

@@ -49,7 +49,7 @@ import torch
 from torch.autograd.function import once_differentiable
 
 from diff_rigid_body import torch as drb_torch
-from diff_rigid_body.trajectory_fitting import CallCounter
+from diff_rigid_body_examples.trajectory_fitting import CallCounter
 
 __all__ = ['integrate', 'Trajectory', 'residuals', 'covariance', 'standard_errors', 'fit_least_squares', 'fit_torch', 'fit_growing',
            'Fit', 'rpy_matrix', 'body_rates', 'rpy_rates', 'angular_momentum', 'sign_change', 'flip_times']
