@@ -4,6 +4,7 @@
 // (rigid_body_client.h) and RigidBodyPool (rigid_body_pool.h), so that every batched call
 // (vertexJacobians, backprop too) takes the same argument type. A CRTP base: Derived has the
 // overloads on std::vector<double> and says `using EigenBatches<Derived>::massMatrices;` etc.
+// The dynamics also take one body at one configuration as Eigen vectors.
 #pragma once
 
 #include <string>
@@ -45,6 +46,25 @@ public:
   {
     return derived().forwardDynamics(detail::flatten(qs), detail::flattenOptional(qdots),
                                      detail::flattenOptional(taus), bodies, derivatives);
+  }
+
+  /// One body at one configuration (any Eigen vectors of its d coordinates): inverseDynamics at
+  /// the accelerations `xddot`, forwardDynamics under the generalised forces `tau`.
+  template <typename Q, typename Qdot, typename Qddot>
+  InverseDynamicsResult inverseDynamics(const std::string& body, const Eigen::MatrixBase<Q>& x,
+                                        const Eigen::MatrixBase<Qdot>& xdot, const Eigen::MatrixBase<Qddot>& xddot,
+                                        bool derivatives = false)
+  {
+    return derived().inverseDynamics(detail::values(x), detail::values(xdot), detail::values(xddot), { body },
+                                     false, derivatives);
+  }
+  template <typename Q, typename Qdot, typename Tau>
+  ForwardDynamicsResult forwardDynamics(const std::string& body, const Eigen::MatrixBase<Q>& x,
+                                        const Eigen::MatrixBase<Qdot>& xdot, const Eigen::MatrixBase<Tau>& tau,
+                                        bool derivatives = false)
+  {
+    return derived().forwardDynamics(detail::values(x), detail::values(xdot), detail::values(tau), { body },
+                                     derivatives);
   }
 
 private:

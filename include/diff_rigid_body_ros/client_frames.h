@@ -19,6 +19,7 @@
 #include <diff_rigid_body/GetCenterOfMass.h>
 #include <diff_rigid_body/GetFrameJacobians.h>
 
+#include "diff_rigid_body_ros/client_requests.h"
 #include "diff_rigid_body_ros/client_types.h"
 
 namespace diff_rigid_body_ros
@@ -69,26 +70,19 @@ inline diff_rigid_body::GetFrameJacobians frameJacobiansRequest(const std::strin
                                                                 std::vector<double> q, std::vector<double> qdot,
                                                                 FrameReference reference, bool acceleration_bias)
 {
-  diff_rigid_body::GetFrameJacobians srv;
-  srv.request.body = body;
-  srv.request.frames = frames;
-  srv.request.q = std::move(q);
-  srv.request.qdot = std::move(qdot);
-  srv.request.reference = static_cast<std::uint8_t>(reference);
-  srv.request.acceleration_bias = acceleration_bias;
-  return srv;
+  using R = diff_rigid_body::GetFrameJacobians::Request;
+  return requestOf<diff_rigid_body::GetFrameJacobians>(&R::body, body, &R::frames, frames, &R::q, std::move(q),
+                                                       &R::qdot, std::move(qdot), &R::reference, reference,
+                                                       &R::acceleration_bias, acceleration_bias);
 }
 
 inline diff_rigid_body::GetCenterOfMass centerOfMassRequest(const std::vector<std::string>& bodies,
                                                             std::vector<double> q, std::vector<double> qdot,
                                                             bool jacobians)
 {
-  diff_rigid_body::GetCenterOfMass srv;
-  srv.request.bodies = bodies;
-  srv.request.q = std::move(q);
-  srv.request.qdot = std::move(qdot);
-  srv.request.jacobians = jacobians;
-  return srv;
+  using R = diff_rigid_body::GetCenterOfMass::Request;
+  return requestOf<diff_rigid_body::GetCenterOfMass>(&R::bodies, bodies, &R::q, std::move(q), &R::qdot,
+                                                     std::move(qdot), &R::jacobians, jacobians);
 }
 }  // namespace detail
 

@@ -127,15 +127,6 @@ public:
     return toInverseDynamics(srv.response);
   }
   using EigenBatches<RigidBodyClient>::inverseDynamics;
-  /// One body at one configuration (any Eigen vectors of its d coordinates).
-  template <typename Q, typename Qdot, typename Qddot>
-  InverseDynamicsResult inverseDynamics(const std::string& body, const Eigen::MatrixBase<Q>& x,
-                                        const Eigen::MatrixBase<Qdot>& xdot, const Eigen::MatrixBase<Qddot>& xddot,
-                                        bool derivatives = false)
-  {
-    return inverseDynamics(detail::values(x), detail::values(xdot), detail::values(xddot), { body }, false,
-                           derivatives);
-  }
 
   /// x'' = M(x)^-1 (tau - c(x, x') - g(x)) [rad/s^2, m/s^2] of `bodies` (empty = all), laid out as
   /// inverseDynamics (`tau` [N m, N] in place of qddot); `derivatives` adds dx''/dx, dx''/dx' and
@@ -150,14 +141,6 @@ public:
     return toForwardDynamics(srv.response);
   }
   using EigenBatches<RigidBodyClient>::forwardDynamics;
-  /// One body at one configuration (any Eigen vectors of its d coordinates).
-  template <typename Q, typename Qdot, typename Tau>
-  ForwardDynamicsResult forwardDynamics(const std::string& body, const Eigen::MatrixBase<Q>& x,
-                                        const Eigen::MatrixBase<Qdot>& xdot, const Eigen::MatrixBase<Tau>& tau,
-                                        bool derivatives = false)
-  {
-    return forwardDynamics(detail::values(x), detail::values(xdot), detail::values(tau), { body }, derivatives);
-  }
 
   /// Poses and Jacobians (client_frames.h) of `body`'s link `frames` (empty = every link of the
   /// body) at K configurations: `q` K d values (empty = the current state), `qdot` q's length or

@@ -174,8 +174,11 @@ class ServiceRegistry(unittest.TestCase):
                             'rigid_body_client.h: RigidBodyClient declares no %s() for %s'
                             % (e['cpp_method'], e['name']))
             self.assertIn('"%s"' % e['name'], header, 'rigid_body_client.h never calls %s' % e['name'])
-            self.assertIn('diff_rigid_body::%s srv' % e['srv_type'], requests,
-                          'rigid_body_client.h (with client_requests.h, client_frames.h) never builds a diff_rigid_body::%s for %s' % (e['srv_type'], e['name']))
+            built = re.search(r'diff_rigid_body::%s srv\b|requestOf<diff_rigid_body::%s>' % (e['srv_type'], e['srv_type']),
+                              requests)
+            self.assertTrue(built,
+                            'rigid_body_client.h (with client_requests.h, client_frames.h) never builds a diff_rigid_body::%s for %s'
+                            % (e['srv_type'], e['name']))
 
     def test_pools_shard_every_batched_service(self):
         cpp = {name: (set(re.findall(r'&Request::(\w+)', request)), set(re.findall(r'&Response::(\w+)', response)))
