@@ -35,6 +35,10 @@ std::uint64_t nextQueriesId()
 
 void requireFinite(const double* values, std::size_t count, const char* field)
 {
+  // Eigen's allFinite is a vectorised x - x == 0 test over the whole array; the loop below
+  // only runs to name the first value that is not finite.
+  if (Eigen::Map<const Eigen::ArrayXd>(values, static_cast<Eigen::Index>(count)).allFinite())
+    return;
   for (std::size_t i = 0; i < count; ++i)
   {
     if (!std::isfinite(values[i]))
