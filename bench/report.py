@@ -20,6 +20,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 from report_format import NOT_NODE, fmt_ratio, fmt_time, kernel_table, load, md_table, verdict  # noqa: E402
 from report_articulated import section_articulated  # noqa: E402
 from report_gimbal import section_gimbal  # noqa: E402
+from report_local import section_from as section_local  # noqa: E402
 from report_kernels import (plot_kernels, section_backprop, section_floors, section_jacobians,  # noqa: E402
                             section_mass_matrix)
 
@@ -305,6 +306,9 @@ def main():
     pool_path = os.path.join(args.results, "pool.md")  # written by bench/pool_throughput.py
     if os.path.exists(pool_path):
         parts.append(open(pool_path).read().strip())
+    local = section_local(args.results, targets)  # local.json (bench/local_throughput.py), local_kernels.json
+    if local:
+        parts.append(local)
     plot_kernels(k, acc, args.docs)
 
     info = machine(args.workspace, kernels_json, args.repo, args.results)
