@@ -8,7 +8,8 @@ docs/benchmarks.md). Writes DIR/local.json with, per measurement, seconds per ca
 timing windows of the windows' means, and the best window):
   * kernel: LocalScene's calls that drb_bench_local (bench/bench_local.cpp) times in C++ on the
     same inputs: M of the UR5 and of the Panda (K = 1), backprop of the UR5 (K = 1000, 400 vertices);
-    also the compiled module's call alone (diff_rigid_body._local, no Python wrapper);
+    also the compiled module's call alone (diff_rigid_body._local, no Python wrapper) and, with
+    --bin, the C++ row itself (one drb_bench_local run per window), all taking turns;
   * trajectory: bench/client_trajectory.py's loss and gradient at T = 1000 (batched) through
     diff_rigid_body.torch on a LocalScene, against the same module calls replayed (the core's time);
   * node: the same backprop and trajectory through RigidBodyClient's tcpros buffer transport to a
@@ -16,7 +17,7 @@ timing windows of the windows' means, and the best window):
   * dask: forward dynamics with derivatives of the floating humanoid (simple_humanoid.urdf with
     floating_base, as local_dask.test), K = 20000, over a distributed.LocalCluster of 1 and of 2
     worker processes (one thread each), checked bit for bit against LocalScene in this process
-    (calls of REFERENCE_K configurations: one call of all K is over the core's answer limit), and
+    (bench/local_dask_throughput.py; calls of 5000 configurations: one call of all K is over the core's answer limit), and
     the same shards computed with their answers left on the workers (no transfer);
   * memory: a K = 100000 batch (M of the UR5; positions of 32 UR5 vertices) in a fresh process:
     RSS before and peak RSS (VmHWM, reset just before the call) after, against the answer's bytes
@@ -44,7 +45,6 @@ PANDA = os.path.join(ROBOTS, 'panda_description/urdf/panda.urdf')
 HUMANOID = os.path.join(ROBOTS, 'simple_humanoid_description/urdf/simple_humanoid.urdf')
 DEMO = os.path.join(REPO, 'urdf/demo_scene.urdf')
 PARTS = ('kernel', 'trajectory', 'node', 'memory', 'dask')
-REFERENCE_K = 5000  # configurations per in-process reference call of the Dask batch
 
 
 def log(text):
@@ -71,26 +71,61 @@ def selected_vertices(count, N):
     return (np.arange(N, dtype=np.uint64) * count // N).astype(np.uint32)
 
 
-def timed(call, window, windows):
-    """{'median', 'best'}: seconds per call of ``call()``, over ``windows`` windows of at least
-    ``window`` seconds (and one call) each, after a warm-up of one window and at least 3 calls (a
-    node's service threads fault in their malloc arenas' pages on the first large requests)."""
+def warm_up(call, window):
+    """Calls ``call()`` for one window and at least 3 calls (a node's service threads fault in
+    their malloc arenas' pages on the first large requests)."""
     start = time.perf_counter()
     for count in range(1 << 30):
         if count >= 3 and time.perf_counter() - start >= window:
             break
         call()
-    means = []
+
+
+def window_mean(call, window):
+    """[s] per call of ``call()``, the mean over one window of at least ``window`` seconds."""
+    count, start = 0, time.perf_counter()
+    while True:
+        call()
+        count += 1
+        elapsed = time.perf_counter() - start
+        if elapsed >= window:
+            return elapsed / count
+
+
+def summary(means):
+    return {'median': float(np.median(means)), 'best': float(min(means)), 'windows': len(means)}
+
+
+def timed(call, window, windows):
+    """{'median', 'best'}: seconds per call of ``call()``, over ``windows`` windows of at least
+    ``window`` seconds each, after a warm-up."""
+    return interleaved({'call': call}, window, windows)['call']
+
+
+def interleaved(calls, window, windows, windowed=None):
+    """{name: {'median', 'best'}} for every ``calls[name]()`` (and every ``windowed[name]()``,
+    which measures one window itself and returns its seconds per call): the sides take turns,
+    one window each, ``windows`` times, so that a slow phase of a shared machine lands on all."""
+    for call in calls.values():
+        warm_up(call, window)
+    sides = {name: (lambda c=call: window_mean(c, window)) for name, call in calls.items()}
+    sides.update(windowed or {})
+    means = {name: [] for name in sides}
     for _ in range(windows):
-        count, start = 0, time.perf_counter()
-        while True:
-            call()
-            count += 1
-            elapsed = time.perf_counter() - start
-            if elapsed >= window:
-                break
-        means.append(elapsed / count)
-    return {'median': float(np.median(means)), 'best': float(min(means)), 'windows': windows}
+        for name, side in sides.items():
+            means[name].append(side())
+    return {name: summary(values) for name, values in means.items()}
+
+
+def core_window(binary, row, window):
+    """[s] per call of drb_bench_local's row ``row`` over one window (a run of its own: the C++
+    core call that LocalScene makes, on the same inputs), or None without the binary."""
+    if not binary:
+        return None
+    text = subprocess.run([binary, '--benchmark_filter=^local/%s$' % row, '--benchmark_min_time=%g' % window,
+                           '--benchmark_format=json'], check=True, capture_output=True, text=True).stdout
+    run = json.loads(text)['benchmarks'][0]
+    return run['real_time'] * {'ns': 1e-9, 'us': 1e-6, 'ms': 1e-3, 's': 1.0}[run['time_unit']]
 
 
 def ur5_backprop_request(scene, K=1000, N=400):
@@ -101,23 +136,28 @@ def ur5_backprop_request(scene, K=1000, N=400):
 
 
 def measure_kernel_side(args):
-    """LocalScene's per-call times for drb_bench_local's rows, and the module call alone."""
+    """LocalScene's per-call times for drb_bench_local's rows, the module call alone and (with
+    --bin) the row's C++ core call, taking turns."""
     from diff_rigid_body import LocalScene
     out = {}
+
+    def core(row):
+        return {'core': lambda: core_window(args.bin, row, args.window)} if args.bin else None
     for robot, urdf in (('ur5', UR5), ('panda', PANDA)):
         scene = LocalScene(urdf_path=urdf)
         q = configurations(1, int(sum(scene.bodies().dofs)), robot == 'panda')
         flat = q.reshape(-1)  # the module takes flat fields, as the wrapper passes them
-        out['%s/mass_matrix_K1' % robot] = dict(
-            local=timed(lambda: scene.mass_matrix(q=q), args.window, args.windows),
-            module=timed(lambda: scene._scene.get_mass_matrix(bodies=[], q=flat), args.window, args.windows))
+        row = '%s/mass_matrix_K1' % robot
+        out[row] = interleaved(dict(local=lambda: scene.mass_matrix(q=q),
+                                    module=lambda: scene._scene.get_mass_matrix(bodies=[], q=flat)),
+                               args.window, args.windows, core(row))
     scene = LocalScene(urdf_path=UR5)
     r = ur5_backprop_request(scene)
     raw = dict(body=r['body'], vertices=r['vertices'], gradients=r['gradients'].ravel(), q=r['q'].ravel())
-    out['ur5/backprop_K1000_N400'] = dict(
-        local=timed(lambda: scene.backprop(**r), args.window, args.windows),
-        module=timed(lambda: scene._scene.backprop(**raw), args.window, args.windows),
-        request_bytes=int(r['gradients'].nbytes + r['q'].nbytes + r['vertices'].nbytes))
+    row = 'ur5/backprop_K1000_N400'
+    out[row] = interleaved(dict(local=lambda: scene.backprop(**r), module=lambda: scene._scene.backprop(**raw)),
+                           args.window, args.windows, core(row))
+    out[row]['request_bytes'] = int(r['gradients'].nbytes + r['q'].nbytes + r['vertices'].nbytes)
     return out
 
 
@@ -169,9 +209,9 @@ def measure_trajectory(args):
     recorder.recording = True
     loss, gradient = trajectory_gradient(scene, setup)
     del scene.call  # the class's own call again, unwrapped, for the timing
-    result = dict(local=timed(lambda: trajectory_gradient(scene, setup), args.window, args.windows),
-                  kernels=timed(recorder.replay, args.window, args.windows),
-                  calls=[name for name, _ in recorder.calls])
+    result = interleaved(dict(local=lambda: trajectory_gradient(scene, setup), kernels=recorder.replay),
+                         args.window, args.windows)
+    result['calls'] = [name for name, _ in recorder.calls]
     result['in_calls'] = seconds_in_calls(scene, setup, args.window)
     return result, (loss, gradient)
 
@@ -227,74 +267,6 @@ def same_result(a, b):
     return a.dtype == b.dtype and a.shape == b.shape and a.tobytes() == b.tobytes()
 
 
-def local_reference(scene, request, K):
-    """forward_dynamics of all K in this process: LocalScene calls of REFERENCE_K configurations
-    (one call of all K is over the core's answer limit, 25.2 M values), joined along K
-    (each configuration is computed on its own: the bits of one call)."""
-    from diff_rigid_body.dask_batches import join
-    parts = []
-    for start in range(0, K, REFERENCE_K):
-        part = dict((name, value[start:start + REFERENCE_K] if name in ('q', 'qdot', 'tau') else value)
-                    for name, value in request.items())
-        parts.append(scene.forward_dynamics(**part))
-    return join(parts)
-
-
-def compute_only(client, description, request):
-    """[s] map_configurations' shards computed with their answers left on the workers (no
-    gather, no join): the cluster's computation and scheduling without the answer's transfer."""
-    from distributed import wait
-    from diff_rigid_body import dask_batches as db
-    K = request['q'].shape[0]
-    shards = max(2 * sum(client.nthreads().values()), -(-K // db.SHARD_CONFIGURATIONS))
-    start = time.perf_counter()
-    scattered = client.scatter([description], broadcast=True, hash=False)[0]
-    futures = [client.submit(db.compute_shard, scattered, 'forward_dynamics',
-                             dict((name, value[a:b] if name in db.PER_CONFIGURATION else value)
-                                  for name, value in request.items()), pure=False)
-               for a, b in db.shard_bounds(K, shards)]
-    wait(futures)
-    elapsed = time.perf_counter() - start
-    client.cancel(futures)
-    return elapsed
-
-
-def measure_dask(args):
-    """forward_dynamics with derivatives, K configurations of the floating humanoid, over a
-    LocalCluster of n = 1 and 2 worker processes; the single-process call for reference."""
-    from distributed import Client, LocalCluster
-    from diff_rigid_body import LocalScene
-    from diff_rigid_body.dask_batches import SceneDescription, map_configurations
-    description = SceneDescription.from_file(HUMANOID, floating_base=True)
-    scene = LocalScene(urdf=description.urdf, **description.options)
-    d = int(sum(scene.bodies().dofs))
-    q = configurations(args.dask_k, d)
-    qdot, tau = np.ascontiguousarray(q[::-1] * 0.5), np.ascontiguousarray(np.roll(q, 1, axis=1))
-    request = dict(q=q, qdot=qdot, tau=tau, derivatives=True)
-    start = time.perf_counter()
-    reference = local_reference(scene, request, args.dask_k)
-    out = dict(K=args.dask_k, coordinates=d, single_process=time.perf_counter() - start,
-               reference_calls=-(-args.dask_k // REFERENCE_K),
-               answer_bytes=int(sum(np.asarray(x).nbytes for x in reference[1:5])))
-    log('dask: in process, %d LocalScene calls: %.2f s' % (out['reference_calls'], out['single_process']))
-    for workers in (1, 2):
-        with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
-                Client(cluster) as client:
-            mapped = map_configurations(client, description, 'forward_dynamics', **request)  # loads the scenes
-            seconds, computing = [], []
-            for _ in range(args.dask_repeats):
-                start = time.perf_counter()
-                map_configurations(client, description, 'forward_dynamics', **request)
-                seconds.append(time.perf_counter() - start)
-                computing.append(compute_only(client, description, request))
-            out['workers_%d' % workers] = dict(median=float(np.median(seconds)), best=float(min(seconds)),
-                                               compute_only=float(np.median(computing)),
-                                               same_bits=bool(same_result(mapped, reference)))
-            del mapped
-        log('dask: %d worker(s): %.2f s' % (workers, out['workers_%d' % workers]['median']))
-    return out
-
-
 def memory_child(kind, K):
     """In a fresh process: peak RSS [bytes] before and after one K-configuration call, and the
     answer's bytes. The scene is loaded and called once at K = 1 first (its per-thread workspace)."""
@@ -343,12 +315,14 @@ def measure_memory(K):
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument('--out', help='results folder: writes local.json')
+    parser.add_argument('--bin', help='folder of drb_bench_local: its core rows take turns with LocalScene')
     parser.add_argument('--quick', action='store_true', help='short windows, one Dask repeat (a smoke run)')
     parser.add_argument('--parts', nargs='+', choices=PARTS, default=list(PARTS), help='what to measure')
     parser.add_argument('--memory-child', choices=['mass_matrix', 'positions'], help=argparse.SUPPRESS)
     parser.add_argument('--memory-k', type=int, default=100000, help='K of the memory batch')
     parser.add_argument('--dask-k', type=int, default=20000, help='K of the Dask batch')
     args = parser.parse_args()
+    args.bin = os.path.join(args.bin, 'drb_bench_local') if args.bin else None
     robots = os.path.join(REPO, 'test/robots')  # package:// meshes of the Panda, the UR5 and the humanoid
     os.environ['ROS_PACKAGE_PATH'] = robots + ':' + os.environ.get('ROS_PACKAGE_PATH', '')
     if args.memory_child:
@@ -375,6 +349,7 @@ def main():
         result['memory'] = measure_memory(args.memory_k)
     if 'dask' in args.parts:
         log('dask LocalCluster, K = %d' % args.dask_k)
+        from local_dask_throughput import measure_dask  # bench/, beside this file
         result['dask'] = measure_dask(args)
     result['seconds'] = time.monotonic() - started
     result['load'] = [load_at_start, os.getloadavg()[0]]  # 1-minute load average: how quiet the machine was

@@ -35,7 +35,8 @@ def call_rows(local, kernels):
     for key, label in labels.items():
         x = local["kernel"][key]
         n = node.get(key, {}).get("node")
-        rows.append((key, label, kernel_seconds(kernels, "local/" + key), x["module"]["median"],
+        core = x["core"]["median"] if "core" in x else kernel_seconds(kernels, "local/" + key)  # taking turns
+        rows.append((key, label, core, x["module"]["median"],
                      x["local"]["median"], n["median"] if n else None))
     t = local["trajectory"]
     n = node.get("trajectory_T1000", {}).get("node")
@@ -142,13 +143,14 @@ def section_local(local, kernels_json, targets):
             "drb_bench_local (bench/bench_local.cpp): the same inputs (exact binary fractions, formulas in "
             "bench_local.cpp) through the C++ core call LocalScene makes (`SceneQueries::massMatrices` / "
             "`backpropConfigurations`, a fresh answer per call, the 9.6 MB of gradients on transparent huge pages as "
-            "numpy allocates them; Google Benchmark, wall time, median of the repetitions), the compiled "
+            "numpy allocates them; Google Benchmark wall time: one drb_bench_local run per window, taking turns with "
+            "the Python windows, or else the median of its repetitions), the compiled "
             "module's call alone (`diff_rigid_body._local`), `LocalScene`'s method, and the node through "
             "`RigidBodyClient`'s tcpros buffer transport (`rigid_body_server` under its own roscore, same "
             "machine)." + (" 1-minute load average %.2f at the start, %.2f at the end." % tuple(local["load"])
                            if "load" in local else "") +
-            f" Python times: median over {local['windows']} windows of ≥ "
-            f"{local['window_s']:g} s of the mean per call. The trajectory row is bench/client_trajectory.py's batched "
+            f" Times: median over {local['windows']} windows of ≥ "
+            f"{local['window_s']:g} s of the mean per call, the columns of a row taking turns window by window. The trajectory row is bench/client_trajectory.py's batched "
             "loss and gradient; its core column is the same module calls replayed (" +
             ", ".join(local["trajectory"]["calls"]) + ").", "",
             md_table(["call", "C++ core", "module call", "LocalScene", "node (tcpros)", "LocalScene ÷ core",
