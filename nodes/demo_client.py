@@ -135,7 +135,7 @@ def t_handle_example(client, noise, frames, drop_dqddot_dq=False):
     inertia = bodies.inertias[i]
     x_hidden = t_handle.hidden_toss()
     vertices = np.arange(0, bodies.vertex_counts[i], 4).astype(np.uint32)
-    gravity = np.asarray(client.forward_dynamics(x_hidden[None, None, :6], bodies=[T_HANDLE]).qddot).reshape(6)[3:]
+    gravity = np.asarray(client.forward_dynamics([T_HANDLE], x_hidden[None, None, :6]).qddot).reshape(6)[3:]
     print('\n3. A tossed T-handle (%s, body %r): %.5f kg, I_b diagonal (%s) kg m^2, %d vertices' % (
         getattr(client, 'server', 'in process, LocalScene'), T_HANDLE, bodies.masses[i],
         ', '.join('%.3e' % v for v in np.diag(inertia)),

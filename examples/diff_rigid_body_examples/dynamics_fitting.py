@@ -62,7 +62,7 @@ Fit = collections.namedtuple('Fit', 'x iterations evaluations calls residual_rms
 def _stage(client, body, s, d, sensitivities, drop_dqddot_dq):
     """f(s) (K, 2d) and, with ``sensitivities``, df/ds (K, 2d, 2d) of the K states ``s``: one call."""
     K = len(s)
-    answer = client.forward_dynamics(s[:, None, :d], s[:, None, d:], bodies=[body], derivatives=sensitivities)
+    answer = client.forward_dynamics([body], s[:, None, :d], s[:, None, d:], derivatives=sensitivities)
     f = np.concatenate([s[:, d:], np.asarray(answer.qddot).reshape(K, d)], axis=1)
     if not sensitivities:
         return f, None

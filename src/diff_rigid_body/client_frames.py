@@ -16,6 +16,7 @@ import collections
 
 import numpy as np
 
+from diff_rigid_body.client_arguments import earlier_order, names_at
 from diff_rigid_body.client_arrays import AnswerShape, optional_values, vertex_configurations
 from diff_rigid_body.client_names import body_names
 
@@ -64,7 +65,9 @@ def com_jacobians(values, dofs, configurations, batched):
 class FrameQueries(object):
     """The frame and centre-of-mass methods of :class:`~diff_rigid_body.client.RigidBodyClient`."""
 
-    def frame_jacobians(self, body, q=None, frames=None, reference='local_world_aligned', qdot=None,
+    @earlier_order(('body', 'q', 'frames', 'reference', 'qdot', 'acceleration_bias'),
+                   names_at(2, or_value_at=3, values=tuple(REFERENCES) + tuple(REFERENCES.values())), leading=1)
+    def frame_jacobians(self, body, q=None, qdot=None, frames=None, reference='local_world_aligned',
                         acceleration_bias=False):
         """Poses and Jacobians of ``body``'s link ``frames`` (None = every link of the body; merged
         links and static links are frames too) at ``q`` (None = current state, (d,), or (K, d)), as

@@ -8,6 +8,7 @@ methods lay out the requests and shape the answers (shapes: the module docstring
 """
 import numpy as np
 
+from diff_rigid_body.client_arguments import earlier_order, numbers_before_names
 from diff_rigid_body.client_arrays import (AnswerShape, floats, indices, optional_values, vertex_blocks,
                                           vertex_configurations)
 from diff_rigid_body.client_frames import FrameQueries
@@ -56,7 +57,9 @@ class SceneQueries(FrameQueries):
         return MassMatrices(list(r.bodies), shape.field(r.mass_matrices, 2), shape.field(r.derivatives, 3, derivatives),
                             shape.per_body_scalars(r.cos_theta))
 
-    def inverse_dynamics(self, q=None, qdot=None, qddot=None, bodies=None, coriolis_matrices=False,
+    @earlier_order(('q', 'qdot', 'qddot', 'bodies', 'coriolis_matrices', 'derivatives'), numbers_before_names(3),
+                   leading=1)
+    def inverse_dynamics(self, bodies=None, q=None, qdot=None, qddot=None, coriolis_matrices=False,
                          derivatives=False):
         """tau = M(x) x'' + c(x, x') + g(x) of ``bodies`` (None = all), as
         :data:`InverseDynamicsResult`; defined everywhere (gimbal lock too).
@@ -80,7 +83,8 @@ class SceneQueries(FrameQueries):
                                      shape.field(r.dtau_dq, 2, derivatives), shape.field(r.dtau_dqdot, 2, derivatives),
                                      shape.per_body_scalars(r.cos_theta))
 
-    def forward_dynamics(self, q=None, qdot=None, tau=None, bodies=None, derivatives=False):
+    @earlier_order(('q', 'qdot', 'tau', 'bodies', 'derivatives'), numbers_before_names(3), leading=1)
+    def forward_dynamics(self, bodies=None, q=None, qdot=None, tau=None, derivatives=False):
         """x'' = M(x)^-1 (tau - c(x, x') - g(x)) of ``bodies`` (None = all), as
         :data:`ForwardDynamicsResult`.
 

@@ -8,10 +8,10 @@ the CPU; a free body's x is q = (phi, theta, psi, tx, ty, tz), d = 6):
 ``vertex_positions(client, body, q)``    q (K, d) -> p (K, N, 3) [m]; q (d,) -> (N, 3)
 ``mass_matrix(client, body, q)``         q (K, d) -> M (K, d, d); q (d,) -> (d, d)
 ``kinetic_energy(client, body, q, qd)``  q, qdot (K, d) -> E (K,) [J]; (d,) -> ()
-``inverse_dynamics(client, q, qd,        q, qdot, qddot (K, d) -> tau (K, d) [N m, N];
-qdd, body)``                             (d,) -> (d,)
-``forward_dynamics(client, q, qd, tau,   q, qdot, tau (K, d) -> qddot (K, d)
-body)``                                  [rad/s^2, m/s^2]; (d,) -> (d,)
+``inverse_dynamics(client, body, q, qd,  q, qdot, qddot (K, d) -> tau (K, d) [N m, N];
+qdd)``                                   (d,) -> (d,)
+``forward_dynamics(client, body, q, qd,  q, qdot, tau (K, d) -> qddot (K, d)
+tau)``                                   [rad/s^2, m/s^2]; (d,) -> (d,)
 =======================================  ==========================================
 
 Each forward pass is one service call for all K configurations
@@ -29,10 +29,15 @@ an input needs a gradient: their backward passes multiply grad_output by
 these Jacobians and call nothing.
 ``per_frame=True`` makes one call per configuration instead (same numbers:
 for comparisons). The node's state is never changed. First derivatives only.
+Arguments come in the clients' order (``client_arguments``): the body, then the
+per-configuration tensors; the earlier ``inverse_dynamics(client, q, qd, qdd, body)``
+still works, with a DeprecationWarning.
 """
 import numpy as np
 import torch
 from torch.autograd.function import once_differentiable
+
+from diff_rigid_body.client_arguments import earlier_order, numbers_before_names
 
 __all__ = ['vertex_positions', 'mass_matrix', 'kinetic_energy', 'inverse_dynamics', 'forward_dynamics',
            'positions_batch', 'backprop_batch', 'inverse_dynamics_batch', 'forward_dynamics_batch']
@@ -74,7 +79,7 @@ def inverse_dynamics_batch(client, body, q, qdot, qddot, derivatives=True, mass_
                   for row in _rows(q, qdot, qddot)]
         return tuple(None if part[0] is None else np.concatenate(part) for part in zip(*frames))
     q3 = q.reshape(len(q), 1, -1)  # (K, 1, d): K configurations of one body, batched however small K is
-    answer = client.inverse_dynamics(q3, qdot.reshape(q3.shape), qddot.reshape(q3.shape), [body],
+    answer = client.inverse_dynamics([body], q3, qdot.reshape(q3.shape), qddot.reshape(q3.shape),
                                       derivatives=derivatives)
     M = client.mass_matrix([body], q3).M[:, 0] if mass_matrix else None
     if not derivatives:
@@ -89,7 +94,7 @@ def forward_dynamics_batch(client, body, q, qdot, tau, derivatives=True, per_fra
         frames = [forward_dynamics_batch(client, body, *row, derivatives=derivatives) for row in _rows(q, qdot, tau)]
         return tuple(None if part[0] is None else np.concatenate(part) for part in zip(*frames))
     q3 = q.reshape(len(q), 1, -1)
-    answer = client.forward_dynamics(q3, qdot.reshape(q3.shape), tau.reshape(q3.shape), [body],
+    answer = client.forward_dynamics([body], q3, qdot.reshape(q3.shape), tau.reshape(q3.shape),
                                      derivatives=derivatives)
     if not derivatives:
         return answer.qddot[:, 0], None, None, None
@@ -222,7 +227,8 @@ def _batched_like(q, others, client, body):
     return q2, reshaped, single
 
 
-def inverse_dynamics(client, q, qdot, qddot, body, per_frame=False):
+@earlier_order(('q', 'qdot', 'qddot', 'body', 'per_frame'), numbers_before_names(3), leading=1)
+def inverse_dynamics(client, body, q, qdot, qddot, per_frame=False):
     """tau = M(q) qddot + c(q, qdot) + g(q) [N m, N] of ``body``: (K, d) for inputs (K, d), (d,)
     for (d,). Differentiable in q, qdot and qddot (backward from the same call's dtau/dq,
     dtau/dqdot, and M = dtau/dqddot from get_mass_matrix)."""
@@ -231,7 +237,8 @@ def inverse_dynamics(client, q, qdot, qddot, body, per_frame=False):
     return tau[0] if single else tau
 
 
-def forward_dynamics(client, q, qdot, tau, body, per_frame=False):
+@earlier_order(('q', 'qdot', 'tau', 'body', 'per_frame'), numbers_before_names(3), leading=1)
+def forward_dynamics(client, body, q, qdot, tau, per_frame=False):
     """qddot = M(q)^-1 (tau - c(q, qdot) - g(q)) [rad/s^2, m/s^2] of ``body``: (K, d) for inputs
     (K, d), (d,) for (d,). Differentiable in q, qdot and tau (backward from the same call's
     dqddot/dq, dqddot/dqdot and dqddot/dtau = M^-1). A singular M raises DiffRigidBodyError."""

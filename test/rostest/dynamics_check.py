@@ -83,10 +83,10 @@ class Scene(object):
         self.potentials = [potential_for_body(bodies, i) for i in range(len(self.bodies))]
 
     def inverse(self, *args, **kwargs):
-        return self.client.inverse_dynamics(*args, bodies=self.bodies, **kwargs)
+        return self.client.inverse_dynamics(self.bodies, *args, **kwargs)
 
     def forward(self, *args, **kwargs):
-        return self.client.forward_dynamics(*args, bodies=self.bodies, **kwargs)
+        return self.client.forward_dynamics(self.bodies, *args, **kwargs)
 
     def mass_matrices(self, q, derivatives=False):
         return self.client.mass_matrix(self.bodies, q, derivatives)
@@ -250,12 +250,12 @@ class Dynamics(unittest.TestCase):
         s = self.scenes[0]  # the Panda, served again with ~gravity [0, 0, 0]
         body = self.zero_gravity.bodies().names
         self.assertEqual(body, s.bodies, 'the zero-gravity node serves another robot')
-        zero = self.zero_gravity.inverse_dynamics(s.x, s.xdot, s.xddot, bodies=body)
+        zero = self.zero_gravity.inverse_dynamics(body, s.x, s.xdot, s.xddot)
         self.assertTrue(np.all(zero.g == 0.0), 'g with ~gravity [0, 0, 0]: %s' % zero.g)
         default = s.inverse(s.x, s.xdot, s.xddot)
         self.report(s, 'tau without gravity vs tau - g', relative_error(zero.tau, default.tau - default.g), EXACT)
         self.assertGreater(np.abs(default.g).max(), 1.0, 'the default node has gravity')
-        rest = self.zero_gravity.forward_dynamics(s.x, bodies=body).qddot
+        rest = self.zero_gravity.forward_dynamics(body, s.x).qddot
         self.assertTrue(np.all(rest == 0.0), 'at rest without gravity or forces x\'\' = 0, got %s' % rest)
 
 

@@ -213,8 +213,8 @@ class LocalSceneAgainstNode(unittest.TestCase):
         losses = (
             lambda c, q: drb_torch.vertex_positions(c, body, q, vertices=list(range(0, count, 7))).sum(),
             lambda c, q: drb_torch.kinetic_energy(c, body, q, q.detach() + 0.5).sum(),
-            lambda c, q: drb_torch.inverse_dynamics(c, q, q * 0.5, q * 0.25, body).sum(),
-            lambda c, q: drb_torch.forward_dynamics(c, q, q * 0.5, q * 0.25, body).sum(),
+            lambda c, q: drb_torch.inverse_dynamics(c, body, q, q * 0.5, q * 0.25).sum(),
+            lambda c, q: drb_torch.forward_dynamics(c, body, q, q * 0.5, q * 0.25).sum(),
             lambda c, q: sum(part.sum() for part in torch_frames.frame_pose(c, body, frame, q)),
             lambda c, q: torch_frames.center_of_mass(c, body, q).sum(),
         )

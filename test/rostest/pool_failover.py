@@ -120,11 +120,11 @@ class PoolFailover(unittest.TestCase):
             q3, where = q[:, None, :], 'K = %d' % K
             for a, b in zip(pool.mass_matrix(q=q3, derivatives=True), one.mass_matrix(q=q3, derivatives=True)):
                 self.assertTrue(same_bits(np.asarray(a), np.asarray(b)), 'mass_matrix ' + where)
-            for a, b in zip(pool.inverse_dynamics(q3, 0.5 * q3, -q3, coriolis_matrices=True, derivatives=True),
-                            one.inverse_dynamics(q3, 0.5 * q3, -q3, coriolis_matrices=True, derivatives=True)):
+            for a, b in zip(pool.inverse_dynamics(None, q3, 0.5 * q3, -q3, coriolis_matrices=True, derivatives=True),
+                            one.inverse_dynamics(None, q3, 0.5 * q3, -q3, coriolis_matrices=True, derivatives=True)):
                 self.assertTrue(same_bits(np.asarray(a), np.asarray(b)), 'inverse_dynamics ' + where)
-            for a, b in zip(pool.forward_dynamics(q3, 0.5 * q3, 2 * q3, derivatives=True),
-                            one.forward_dynamics(q3, 0.5 * q3, 2 * q3, derivatives=True)):
+            for a, b in zip(pool.forward_dynamics(None, q3, 0.5 * q3, 2 * q3, derivatives=True),
+                            one.forward_dynamics(None, q3, 0.5 * q3, 2 * q3, derivatives=True)):
                 self.assertTrue(same_bits(np.asarray(a), np.asarray(b)), 'forward_dynamics ' + where)
             vertices = [0, 5, 1129, 5, 600]
             for a, b in zip(pool.vertex_jacobians(BODY, q, vertices), one.vertex_jacobians(BODY, q, vertices)):

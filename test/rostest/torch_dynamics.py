@@ -63,7 +63,7 @@ class TorchDynamics(unittest.TestCase):
     def test_inverse_dynamics_gradcheck(self):
         for name, client, body, x, xdot, xddot in self.cases:
             def inverse(q, qdot, qddot):
-                return drb_torch.inverse_dynamics(client, q, qdot, qddot, body)
+                return drb_torch.inverse_dynamics(client, body, q, qdot, qddot)
             tau = inverse(tensor(x, False), tensor(xdot, False), tensor(xddot, False))
             atol = 20 * np.finfo(float).eps * float(tau.abs().max()) / EPS
             self.gradcheck(inverse, (tensor(x[0]), tensor(xdot[0]), tensor(xddot[0])), name + ', one configuration',
@@ -72,21 +72,21 @@ class TorchDynamics(unittest.TestCase):
 
     def test_forward_dynamics_gradcheck(self):
         for name, client, body, x, xdot, xddot in self.cases:
-            tau = client.inverse_dynamics(x[:, None], xdot[:, None], xddot[:, None], [body]).tau[:, 0]
+            tau = client.inverse_dynamics([body], x[:, None], xdot[:, None], xddot[:, None]).tau[:, 0]
 
             def forward(q, qdot, tau):
-                return drb_torch.forward_dynamics(client, q, qdot, tau, body)
+                return drb_torch.forward_dynamics(client, body, q, qdot, tau)
             self.gradcheck(forward, (tensor(x[0]), tensor(xdot[0]), tensor(tau[0])), name + ', one configuration',
                            ATOL_FORWARD)
             self.gradcheck(forward, (tensor(x), tensor(xdot), tensor(tau)), name + ', K = 3', ATOL_FORWARD)
 
     def test_values_against_the_numpy_client(self):
         for name, client, body, x, xdot, xddot in self.cases:
-            tau = drb_torch.inverse_dynamics(client, tensor(x, False), tensor(xdot, False), tensor(xddot, False), body)
-            served = client.inverse_dynamics(x[:, None], xdot[:, None], xddot[:, None], [body]).tau[:, 0]
+            tau = drb_torch.inverse_dynamics(client, body, tensor(x, False), tensor(xdot, False), tensor(xddot, False))
+            served = client.inverse_dynamics([body], x[:, None], xdot[:, None], xddot[:, None]).tau[:, 0]
             self.assertTrue(np.array_equal(tau.numpy(), served), '%s: tau differs from the numpy client' % name)
-            qddot = drb_torch.forward_dynamics(client, tensor(x, False), tensor(xdot, False), tau, body)
-            served = client.forward_dynamics(x[:, None], xdot[:, None], served[:, None], [body]).qddot[:, 0]
+            qddot = drb_torch.forward_dynamics(client, body, tensor(x, False), tensor(xdot, False), tau)
+            served = client.forward_dynamics([body], x[:, None], xdot[:, None], served[:, None]).qddot[:, 0]
             self.assertTrue(np.array_equal(qddot.numpy(), served), '%s: qddot differs from the numpy client' % name)
             np.testing.assert_allclose(qddot.numpy(), xddot, rtol=0, atol=1e-10 * np.abs(xddot).max(),
                                        err_msg='%s: forward_dynamics(inverse_dynamics(a)) != a' % name)
@@ -96,8 +96,8 @@ class TorchDynamics(unittest.TestCase):
             results = []
             for per_frame in (False, True):
                 inputs = [tensor(v) for v in (x, xdot, xddot)]
-                tau = drb_torch.inverse_dynamics(client, *inputs, body, per_frame=per_frame)
-                qddot = drb_torch.forward_dynamics(client, inputs[0], inputs[1], tau, body, per_frame=per_frame)
+                tau = drb_torch.inverse_dynamics(client, body, *inputs, per_frame=per_frame)
+                qddot = drb_torch.forward_dynamics(client, body, inputs[0], inputs[1], tau, per_frame=per_frame)
                 (tau.sum() + (qddot ** 2).sum()).backward()
                 results.append([tau.detach().numpy(), qddot.detach().numpy()] + [v.grad.numpy() for v in inputs])
             for what, batched, single in zip(('tau', 'qddot', 'dL/dq', 'dL/dqdot', 'dL/dqddot'), *results):
@@ -107,22 +107,22 @@ class TorchDynamics(unittest.TestCase):
     def test_gradient_of_some_inputs_only(self):
         name, client, body, x, xdot, xddot = self.cases[0]
         q = tensor(x)
-        tau = drb_torch.inverse_dynamics(client, q, tensor(xdot, False), tensor(xddot, False), body)
+        tau = drb_torch.inverse_dynamics(client, body, q, tensor(xdot, False), tensor(xddot, False))
         tau.sum().backward()
         full = tensor(x), tensor(xdot), tensor(xddot)
-        drb_torch.inverse_dynamics(client, *full, body).sum().backward()
+        drb_torch.inverse_dynamics(client, body, *full).sum().backward()
         self.assertTrue(np.array_equal(q.grad.numpy(), full[0].grad.numpy()), 'dL/dq with and without other grads')
         qddot = tensor(xddot)
-        drb_torch.inverse_dynamics(client, tensor(x, False), tensor(xdot, False), qddot, body).sum().backward()
+        drb_torch.inverse_dynamics(client, body, tensor(x, False), tensor(xdot, False), qddot).sum().backward()
         M = client.mass_matrix([body], x[:, None]).M[:, 0]
         np.testing.assert_allclose(qddot.grad.numpy(), M.sum(axis=-2), rtol=1e-14, err_msg='dL/dqddot = 1^T M')
 
     def test_refusals(self):
         name, client, body, x, xdot, xddot = self.cases[0]
         with self.assertRaises(ValueError, msg='qdot of another shape than q'):
-            drb_torch.inverse_dynamics(client, tensor(x), tensor(xdot[0]), tensor(xddot), body)
+            drb_torch.inverse_dynamics(client, body, tensor(x), tensor(xdot[0]), tensor(xddot))
         with self.assertRaises(ValueError, msg='q of the wrong width'):
-            drb_torch.forward_dynamics(client, tensor(x[:, :3]), tensor(xdot[:, :3]), tensor(xddot[:, :3]), body)
+            drb_torch.forward_dynamics(client, body, tensor(x[:, :3]), tensor(xdot[:, :3]), tensor(xddot[:, :3]))
         name, client, body, x, xdot, xddot = self.cases[1]
         locked = x.copy()
         locked[1, 1] = np.pi / 2
