@@ -4,21 +4,27 @@
 // (rigid_body_client.h) and RigidBodyPool (rigid_body_pool.h), so that every batched call
 // (vertexJacobians, backprop too) takes the same argument type. A CRTP base: Derived has the
 // overloads on std::vector<double> and says `using EigenBatches<Derived>::massMatrices;` etc.
-// The dynamics also take one body at one configuration as Eigen vectors.
+// The dynamics also take one body at one configuration as Eigen vectors. Every overload takes the
+// body or bodies first, then q and the other per-configuration values (client_earlier_orders.h
+// keeps the earlier orders, deprecated).
 #pragma once
 
 #include <string>
 #include <vector>
 
 #include "diff_rigid_body_ros/client_arrays.h"
+#include "diff_rigid_body_ros/client_earlier_orders.h"
 #include "diff_rigid_body_ros/client_types.h"
 
 namespace diff_rigid_body_ros
 {
 template <typename Derived>
-class EigenBatches
+class EigenBatches : public EarlierOrders<Derived>
 {
 public:
+  using EarlierOrders<Derived>::inverseDynamics;
+  using EarlierOrders<Derived>::forwardDynamics;
+
   /// massMatrices with qs[k] the listed bodies' x concatenated (a Vector6d for one free body).
   template <typename Vector, detail::IfEigenVector<Vector> = 0>
   MassMatrices massMatrices(const std::vector<std::string>& bodies, const std::vector<Vector>& qs,
@@ -29,23 +35,22 @@ public:
 
   /// inverseDynamics with one vector per configuration (qdots, qddots: one per configuration, or none: zeros).
   template <typename Vector, detail::IfEigenVector<Vector> = 0>
-  InverseDynamicsResult inverseDynamics(const std::vector<Vector>& qs, const std::vector<Vector>& qdots = {},
-                                        const std::vector<Vector>& qddots = {},
-                                        const std::vector<std::string>& bodies = {}, bool coriolis_matrices = false,
-                                        bool derivatives = false)
+  InverseDynamicsResult inverseDynamics(const std::vector<std::string>& bodies, const std::vector<Vector>& qs,
+                                        const std::vector<Vector>& qdots = {}, const std::vector<Vector>& qddots = {},
+                                        bool coriolis_matrices = false, bool derivatives = false)
   {
-    return derived().inverseDynamics(detail::flatten(qs), detail::flattenOptional(qdots),
-                                     detail::flattenOptional(qddots), bodies, coriolis_matrices, derivatives);
+    return derived().inverseDynamics(bodies, detail::flatten(qs), detail::flattenOptional(qdots),
+                                     detail::flattenOptional(qddots), coriolis_matrices, derivatives);
   }
 
   /// forwardDynamics with one vector per configuration (qdots, taus: one per configuration, or none: zeros).
   template <typename Vector, detail::IfEigenVector<Vector> = 0>
-  ForwardDynamicsResult forwardDynamics(const std::vector<Vector>& qs, const std::vector<Vector>& qdots = {},
-                                        const std::vector<Vector>& taus = {},
-                                        const std::vector<std::string>& bodies = {}, bool derivatives = false)
+  ForwardDynamicsResult forwardDynamics(const std::vector<std::string>& bodies, const std::vector<Vector>& qs,
+                                        const std::vector<Vector>& qdots = {}, const std::vector<Vector>& taus = {},
+                                        bool derivatives = false)
   {
-    return derived().forwardDynamics(detail::flatten(qs), detail::flattenOptional(qdots),
-                                     detail::flattenOptional(taus), bodies, derivatives);
+    return derived().forwardDynamics(bodies, detail::flatten(qs), detail::flattenOptional(qdots),
+                                     detail::flattenOptional(taus), derivatives);
   }
 
   /// One body at one configuration (any Eigen vectors of its d coordinates): inverseDynamics at
@@ -55,7 +60,7 @@ public:
                                         const Eigen::MatrixBase<Qdot>& xdot, const Eigen::MatrixBase<Qddot>& xddot,
                                         bool derivatives = false)
   {
-    return derived().inverseDynamics(detail::values(x), detail::values(xdot), detail::values(xddot), { body },
+    return derived().inverseDynamics({ body }, detail::values(x), detail::values(xdot), detail::values(xddot),
                                      false, derivatives);
   }
   template <typename Q, typename Qdot, typename Tau>
@@ -63,7 +68,7 @@ public:
                                         const Eigen::MatrixBase<Qdot>& xdot, const Eigen::MatrixBase<Tau>& tau,
                                         bool derivatives = false)
   {
-    return derived().forwardDynamics(detail::values(x), detail::values(xdot), detail::values(tau), { body },
+    return derived().forwardDynamics({ body }, detail::values(x), detail::values(xdot), detail::values(tau),
                                      derivatives);
   }
 

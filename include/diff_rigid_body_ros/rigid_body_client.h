@@ -117,9 +117,9 @@ public:
   /// `q` as for massMatrices (empty = the current state, K = 1), `qdot` [rad/s, m/s] and `qddot`
   /// [rad/s^2, m/s^2] of q's length (for an empty q: the bodies' D values) or empty (zeros).
   /// `coriolis_matrices` adds C, `derivatives` dtau/dx and dtau/dx'. Defined at gimbal lock too.
-  InverseDynamicsResult inverseDynamics(const std::vector<double>& q = {}, const std::vector<double>& qdot = {},
-                                        const std::vector<double>& qddot = {},
-                                        const std::vector<std::string>& bodies = {}, bool coriolis_matrices = false,
+  InverseDynamicsResult inverseDynamics(const std::vector<std::string>& bodies = {},
+                                        const std::vector<double>& q = {}, const std::vector<double>& qdot = {},
+                                        const std::vector<double>& qddot = {}, bool coriolis_matrices = false,
                                         bool derivatives = false)
   {
     auto srv = detail::inverseDynamicsRequest(bodies, q, qdot, qddot, coriolis_matrices, derivatives);
@@ -132,9 +132,9 @@ public:
   /// inverseDynamics (`tau` [N m, N] in place of qddot); `derivatives` adds dx''/dx, dx''/dx' and
   /// dx''/dtau = M^-1. A configuration where M is singular (gimbal lock, a coordinate that moves
   /// no mass) throws ServiceError naming the body and the configuration.
-  ForwardDynamicsResult forwardDynamics(const std::vector<double>& q = {}, const std::vector<double>& qdot = {},
-                                        const std::vector<double>& tau = {},
-                                        const std::vector<std::string>& bodies = {}, bool derivatives = false)
+  ForwardDynamicsResult forwardDynamics(const std::vector<std::string>& bodies = {},
+                                        const std::vector<double>& q = {}, const std::vector<double>& qdot = {},
+                                        const std::vector<double>& tau = {}, bool derivatives = false)
   {
     auto srv = detail::forwardDynamicsRequest(bodies, q, qdot, tau, derivatives);
     call("forward_dynamics", srv);
@@ -146,14 +146,15 @@ public:
   /// body) at K configurations: `q` K d values (empty = the current state), `qdot` q's length or
   /// empty (zeros, for the acceleration bias J'x'). The node's state is not changed.
   FrameJacobians frameJacobians(const std::string& body, const std::vector<double>& q = {},
-                                const std::vector<std::string>& frames = {},
+                                const std::vector<double>& qdot = {}, const std::vector<std::string>& frames = {},
                                 FrameReference reference = FrameReference::LocalWorldAligned,
-                                const std::vector<double>& qdot = {}, bool acceleration_bias = false)
+                                bool acceleration_bias = false)
   {
     auto srv = detail::frameJacobiansRequest(body, frames, q, qdot, reference, acceleration_bias);
     call("get_frame_jacobians", srv);
     return toFrameJacobians(srv.response);
   }
+  using EigenBatches<RigidBodyClient>::frameJacobians;  // the earlier order (client_earlier_orders.h)
 
   /// The centre of mass of `bodies` (empty = all), laid out as massMatrices; `jacobians` adds
   /// dc/dx and the acceleration bias J'x' at `qdot` (q's length, or empty: zeros).

@@ -77,10 +77,9 @@ public:
   }
   using EigenBatches<RigidBodyPool>::massMatrices;  // K configurations as std::vector<Vector6d or VectorXd>
   /// As RigidBodyClient::inverseDynamics (flat q, or one Eigen vector per configuration).
-  InverseDynamicsResult inverseDynamics(const std::vector<double>& q, const std::vector<double>& qdot = {},
-                                        const std::vector<double>& qddot = {},
-                                        const std::vector<std::string>& bodies = {}, bool coriolis_matrices = false,
-                                        bool derivatives = false)
+  InverseDynamicsResult inverseDynamics(const std::vector<std::string>& bodies, const std::vector<double>& q,
+                                        const std::vector<double>& qdot = {}, const std::vector<double>& qddot = {},
+                                        bool coriolis_matrices = false, bool derivatives = false)
   {
     auto srv = detail::inverseDynamicsRequest(bodies, q, qdot, qddot, coriolis_matrices, derivatives);
     call(srv);
@@ -88,9 +87,9 @@ public:
   }
   using EigenBatches<RigidBodyPool>::inverseDynamics;
   /// As RigidBodyClient::forwardDynamics (flat q, or one Eigen vector per configuration).
-  ForwardDynamicsResult forwardDynamics(const std::vector<double>& q, const std::vector<double>& qdot = {},
-                                        const std::vector<double>& tau = {},
-                                        const std::vector<std::string>& bodies = {}, bool derivatives = false)
+  ForwardDynamicsResult forwardDynamics(const std::vector<std::string>& bodies, const std::vector<double>& q,
+                                        const std::vector<double>& qdot = {}, const std::vector<double>& tau = {},
+                                        bool derivatives = false)
   {
     auto srv = detail::forwardDynamicsRequest(bodies, q, qdot, tau, derivatives);
     call(srv);
@@ -99,14 +98,15 @@ public:
   using EigenBatches<RigidBodyPool>::forwardDynamics;
   /// As RigidBodyClient::frameJacobians and centerOfMass, sharded over the instances.
   FrameJacobians frameJacobians(const std::string& body, const std::vector<double>& q,
-                                const std::vector<std::string>& frames = {},
+                                const std::vector<double>& qdot = {}, const std::vector<std::string>& frames = {},
                                 FrameReference reference = FrameReference::LocalWorldAligned,
-                                const std::vector<double>& qdot = {}, bool acceleration_bias = false)
+                                bool acceleration_bias = false)
   {
     auto srv = detail::frameJacobiansRequest(body, frames, q, qdot, reference, acceleration_bias);
     call(srv);
     return toFrameJacobians(srv.response);
   }
+  using EigenBatches<RigidBodyPool>::frameJacobians;  // the earlier order (client_earlier_orders.h)
   CenterOfMassResult centerOfMass(const std::vector<std::string>& bodies, const std::vector<double>& q,
                                   const std::vector<double>& qdot = {}, bool jacobians = false)
   {

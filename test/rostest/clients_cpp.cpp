@@ -85,7 +85,7 @@ TEST(CppClient, FrameJacobiansOfAFreeBodyAndItsMergedLink)
   RigidBodyClient client;
   const auto bodies = client.bodies();
   std::vector<double> q{ 0.3, -0.4, 1.1, 0.05, -0.1, 0.6, -0.7, 0.2, 0.4, 1.0, 2.0, -3.0 };
-  const auto answer = client.frameJacobians("rock", q, {}, diff_rigid_body_ros::FrameReference::LocalWorldAligned);
+  const auto answer = client.frameJacobians("rock", q, {}, {}, diff_rigid_body_ros::FrameReference::LocalWorldAligned);
   ASSERT_EQ(answer.frames, (std::vector<std::string>{ "rock", "rock_handle" }));
   ASSERT_EQ(answer.configurations, 2u);
   ASSERT_EQ(answer.J.size(), 4u);
@@ -154,15 +154,36 @@ TEST(CppClient, BatchedCallsTakeOneEigenVectorPerConfiguration)
     EXPECT_EQ(MX.at(k, 0), M.at(k, 0));
     EXPECT_EQ(M6.dM[k][4], M.dM[k][4]);
   }
-  const auto tau = client.inverseDynamics(flat, flat_qdot, {}, { "knot" });
-  const auto tau6 = client.inverseDynamics(qs, qdots, {}, { "knot" });
-  const auto qddot = client.forwardDynamics(flat, flat_qdot, {}, { "knot" });
-  const auto qddot6 = client.forwardDynamics(qs, qdots, {}, { "knot" });
+  const auto tau = client.inverseDynamics({ "knot" }, flat, flat_qdot);
+  const auto tau6 = client.inverseDynamics({ "knot" }, qs, qdots);
+  const auto qddot = client.forwardDynamics({ "knot" }, flat, flat_qdot);
+  const auto qddot6 = client.forwardDynamics({ "knot" }, qs, qdots);
   ASSERT_EQ(tau6.tau.size(), 3u);
   for (std::size_t k = 0; k < 3; ++k)
   {
     EXPECT_EQ(tau6.tau[k], tau.tau[k]);
     EXPECT_EQ(qddot6.qddot[k], qddot.qddot[k]);
+  }
+  // The earlier orders (client_earlier_orders.h, deprecated) still compile and give the same bits.
+  constexpr auto World = diff_rigid_body_ros::FrameReference::World;
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
+  const auto earlier_tau = client.inverseDynamics(flat, flat_qdot, {}, { "knot" });
+  const auto earlier_tau6 = client.inverseDynamics(qs, qdots, {}, { "knot" });
+  const auto earlier_qddot = client.forwardDynamics(flat, flat_qdot, {}, { "knot" });
+  const auto earlier_qddot6 = client.forwardDynamics(qs, qdots, {}, { "knot" });
+  const std::vector<std::string> frames = client.frameJacobians("knot", flat).frames;
+  const auto earlier_frames = client.frameJacobians("knot", flat, frames, World, flat_qdot, true);
+#pragma GCC diagnostic pop
+  const auto frames_now = client.frameJacobians("knot", flat, flat_qdot, frames, World, true);
+  for (std::size_t k = 0; k < 3; ++k)
+  {
+    EXPECT_EQ(earlier_tau.tau[k], tau.tau[k]);
+    EXPECT_EQ(earlier_tau6.tau[k], tau.tau[k]);
+    EXPECT_EQ(earlier_qddot.qddot[k], qddot.qddot[k]);
+    EXPECT_EQ(earlier_qddot6.qddot[k], qddot.qddot[k]);
+    EXPECT_EQ(earlier_frames.J[k], frames_now.J[k]);
+    EXPECT_EQ(earlier_frames.bias[k], frames_now.bias[k]);
   }
 }
 

@@ -120,13 +120,13 @@ TEST(RigidBodyPool, AnswersEqualOneInstanceBitForBit)
     expectSameBits(M.M, M1.M, "M" + where);
     for (std::size_t m = 0; m < M1.dM.size(); ++m)
       expectSameBits(M.dM.at(m), M1.dM[m], "dM" + where);
-    const auto id = pool.inverseDynamics(flat(qs), flat(qs, 0.5), flat(qs, -0.3), {}, true, true);
-    const auto id1 = one.inverseDynamics(flat(qs), flat(qs, 0.5), flat(qs, -0.3), {}, true, true);
+    const auto id = pool.inverseDynamics({}, flat(qs), flat(qs, 0.5), flat(qs, -0.3), true, true);
+    const auto id1 = one.inverseDynamics({}, flat(qs), flat(qs, 0.5), flat(qs, -0.3), true, true);
     expectSameBits(id.tau, id1.tau, "tau" + where);
     expectSameBits(id.coriolis_matrices, id1.coriolis_matrices, "C" + where);
     expectSameBits(id.dtau_dq, id1.dtau_dq, "dtau_dq" + where);
-    const auto fd = pool.forwardDynamics(flat(qs), flat(qs, 0.5), flat(qs, 2.0), {}, true);
-    const auto fd1 = one.forwardDynamics(flat(qs), flat(qs, 0.5), flat(qs, 2.0), {}, true);
+    const auto fd = pool.forwardDynamics({}, flat(qs), flat(qs, 0.5), flat(qs, 2.0), true);
+    const auto fd1 = one.forwardDynamics({}, flat(qs), flat(qs, 0.5), flat(qs, 2.0), true);
     expectSameBits(fd.qddot, fd1.qddot, "qddot" + where);
     expectSameBits(fd.dqddot_dtau, fd1.dqddot_dtau, "M^-1" + where);
     const std::vector<std::uint32_t> vertices = { 0, 5, 1129, 5, 600 };
@@ -156,8 +156,8 @@ TEST(RigidBodyPool, BatchedCallsTakeOneEigenVectorPerConfiguration)
   for (const Eigen::VectorXd& q : qs)
     flat.insert(flat.end(), q.data(), q.data() + q.size());
   const auto M = pool.massMatrices({ kBody }, flat), MX = pool.massMatrices({ kBody }, qs);
-  const auto tau = pool.inverseDynamics(flat), tauX = pool.inverseDynamics(qs);
-  const auto qddot = pool.forwardDynamics(flat, {}, {}, { kBody }), qddotX = pool.forwardDynamics(qs, {}, {}, { kBody });
+  const auto tau = pool.inverseDynamics({}, flat), tauX = pool.inverseDynamics({}, qs);
+  const auto qddot = pool.forwardDynamics({ kBody }, flat), qddotX = pool.forwardDynamics({ kBody }, qs);
   ASSERT_EQ(MX.configurations, qs.size());
   for (std::size_t k = 0; k < qs.size(); ++k)
   {

@@ -152,7 +152,7 @@ TEST(CppClientArticulated, DynamicsIdentities)
       << "dx''/dtau M = I";
 
   const std::vector<double> x(panda.x.data(), panda.x.data() + d), v(xdot.data(), xdot.data() + d);
-  const auto with_c = panda.client.inverseDynamics(x, v, {}, { panda.body }, /*coriolis_matrices=*/true);
+  const auto with_c = panda.client.inverseDynamics({ panda.body }, x, v, {}, /*coriolis_matrices=*/true);
   ASSERT_EQ(with_c.coriolis_matrices.size(), 1u);
   EXPECT_LE(relativeError(with_c.coriolis_matrices[0] * xdot, c), kTolerance) << "c = C x'";
 }
@@ -169,13 +169,13 @@ TEST(CppClientArticulated, DynamicsOfSeveralConfigurations)
       qdot.push_back(0.1 * (j - k));
       qddot.push_back(0.2 * (k + 1) - 0.1 * j);
     }
-  const auto all = panda.client.inverseDynamics(q, qdot, qddot, { panda.body }, true, true);
+  const auto all = panda.client.inverseDynamics({ panda.body }, q, qdot, qddot, true, true);
   ASSERT_EQ(all.configurations, 3u);
   ASSERT_EQ(all.tau.size(), 3u);
   std::vector<double> tau;
   for (const Eigen::VectorXd& one : all.tau)
     tau.insert(tau.end(), one.data(), one.data() + one.size());
-  const auto forward = panda.client.forwardDynamics(q, qdot, tau, { panda.body }, true);
+  const auto forward = panda.client.forwardDynamics({ panda.body }, q, qdot, tau, true);
   ASSERT_EQ(forward.qddot.size(), 3u);
   for (std::size_t k = 0; k < 3; ++k)
   {
@@ -183,22 +183,22 @@ TEST(CppClientArticulated, DynamicsOfSeveralConfigurations)
       return std::vector<double>(values.begin() + k * d, values.begin() + (k + 1) * d);
     };
     const std::size_t m = all.index(k, 0);
-    const auto one = panda.client.inverseDynamics(slice(q), slice(qdot), slice(qddot), { panda.body }, true, true);
+    const auto one = panda.client.inverseDynamics({ panda.body }, slice(q), slice(qdot), slice(qddot), true, true);
     EXPECT_EQ(all.tau[m], one.tau[0]) << "configuration " << k;
     EXPECT_EQ(all.coriolis_matrices[m], one.coriolis_matrices[0]) << "configuration " << k;
     EXPECT_EQ(all.dtau_dq[m], one.dtau_dq[0]) << "configuration " << k;
     EXPECT_EQ(all.dtau_dqdot[m], one.dtau_dqdot[0]) << "configuration " << k;
-    const auto one_forward = panda.client.forwardDynamics(slice(q), slice(qdot), slice(tau), { panda.body }, true);
+    const auto one_forward = panda.client.forwardDynamics({ panda.body }, slice(q), slice(qdot), slice(tau), true);
     EXPECT_EQ(forward.qddot[m], one_forward.qddot[0]) << "configuration " << k;
     EXPECT_EQ(forward.dqddot_dq[m], one_forward.dqddot_dq[0]) << "configuration " << k;
     const std::vector<double> a = slice(qddot);
     EXPECT_LE(relativeError(forward.qddot[m], Eigen::Map<const Eigen::VectorXd>(a.data(), d)), kInverseTolerance)
         << "FD(ID(a)) = a, configuration " << k;
   }
-  EXPECT_THROW(panda.client.forwardDynamics(q, std::vector<double>(q.size() - 1, 0.0)),
+  EXPECT_THROW(panda.client.forwardDynamics({}, q, std::vector<double>(q.size() - 1, 0.0)),
                diff_rigid_body_ros::ServiceError)
       << "qdot one value short";
-  EXPECT_THROW(panda.client.inverseDynamics(q, {}, {}, { "nope" }), diff_rigid_body_ros::ServiceError)
+  EXPECT_THROW(panda.client.inverseDynamics({ "nope" }, q), diff_rigid_body_ros::ServiceError)
       << "an unknown body";
 }
 

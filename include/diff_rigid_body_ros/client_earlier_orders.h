@@ -1,0 +1,88 @@
+// The earlier argument orders of RigidBodyClient and RigidBodyPool, kept deprecated so that code
+// written against them still compiles (with a warning) and gets the same answers. Every batched
+// call now takes the body or bodies first, then q and the other per-configuration values, then
+// the selection and the options:
+//
+//   earlier (deprecated)                           now
+//   inverseDynamics(q, qdot, qddot, bodies, ...)   inverseDynamics(bodies, q, qdot, qddot, ...)
+//   forwardDynamics(q, qdot, tau, bodies, ...)     forwardDynamics(bodies, q, qdot, tau, ...)
+//   frameJacobians(body, q, frames, reference,     frameJacobians(body, q, qdot, frames, reference,
+//                  qdot, acceleration_bias)                       acceleration_bias)
+//
+// The earlier overloads deduce the type of their first moved argument, so that a braced list
+// there ({} for all bodies) never selects them: `inverseDynamics({}, q)` is the current order.
+// A CRTP base of EigenBatches (client_batches.h).
+#pragma once
+
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "diff_rigid_body_ros/client_arrays.h"
+#include "diff_rigid_body_ros/client_frames.h"
+#include "diff_rigid_body_ros/client_types.h"
+
+namespace diff_rigid_body_ros
+{
+namespace detail
+{
+/// `IfFlat<Values> = 0`: Values is std::vector<double> (K configurations concatenated).
+template <typename Values>
+using IfFlat = std::enable_if_t<std::is_same<Values, std::vector<double>>::value, int>;
+/// `IfEigenBatch<Values> = 0`: Values is a std::vector of Eigen vectors (one per configuration).
+template <typename Values>
+using IfEigenBatch = IfEigenVector<typename Values::value_type>;
+/// A parameter whose type is taken from another one (never deduced from its own argument).
+template <typename T>
+using Same = typename std::common_type<T>::type;
+}  // namespace detail
+
+template <typename Derived>
+class EarlierOrders
+{
+public:
+  template <typename Values, detail::IfFlat<Values> = 0>
+  [[deprecated("inverseDynamics(bodies, q, qdot, qddot, ...): the bodies come first now")]] InverseDynamicsResult
+  inverseDynamics(const Values& q, const Values& qdot = {}, const Values& qddot = {},
+                  const std::vector<std::string>& bodies = {}, bool coriolis_matrices = false,
+                  bool derivatives = false)
+  {
+    return derived().inverseDynamics(bodies, q, qdot, qddot, coriolis_matrices, derivatives);
+  }
+  template <typename Values, detail::IfEigenBatch<Values> = 0>
+  [[deprecated("inverseDynamics(bodies, qs, qdots, qddots, ...): the bodies come first now")]] InverseDynamicsResult
+  inverseDynamics(const Values& qs, const detail::Same<Values>& qdots = {}, const detail::Same<Values>& qddots = {},
+                  const std::vector<std::string>& bodies = {}, bool coriolis_matrices = false,
+                  bool derivatives = false)
+  {
+    return derived().inverseDynamics(bodies, qs, qdots, qddots, coriolis_matrices, derivatives);
+  }
+
+  template <typename Values, detail::IfFlat<Values> = 0>
+  [[deprecated("forwardDynamics(bodies, q, qdot, tau, ...): the bodies come first now")]] ForwardDynamicsResult
+  forwardDynamics(const Values& q, const Values& qdot = {}, const Values& tau = {},
+                  const std::vector<std::string>& bodies = {}, bool derivatives = false)
+  {
+    return derived().forwardDynamics(bodies, q, qdot, tau, derivatives);
+  }
+  template <typename Values, detail::IfEigenBatch<Values> = 0>
+  [[deprecated("forwardDynamics(bodies, qs, qdots, taus, ...): the bodies come first now")]] ForwardDynamicsResult
+  forwardDynamics(const Values& qs, const detail::Same<Values>& qdots = {}, const detail::Same<Values>& taus = {},
+                  const std::vector<std::string>& bodies = {}, bool derivatives = false)
+  {
+    return derived().forwardDynamics(bodies, qs, qdots, taus, derivatives);
+  }
+
+  template <typename Names, std::enable_if_t<std::is_same<Names, std::vector<std::string>>::value, int> = 0>
+  [[deprecated("frameJacobians(body, q, qdot, frames, reference, ...): qdot comes before frames now")]] FrameJacobians
+  frameJacobians(const std::string& body, const std::vector<double>& q, const Names& frames,
+                 FrameReference reference = FrameReference::LocalWorldAligned, const std::vector<double>& qdot = {},
+                 bool acceleration_bias = false)
+  {
+    return derived().frameJacobians(body, q, qdot, frames, reference, acceleration_bias);
+  }
+
+private:
+  Derived& derived() { return static_cast<Derived&>(*this); }
+};
+}  // namespace diff_rigid_body_ros
