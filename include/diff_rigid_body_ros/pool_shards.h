@@ -18,53 +18,42 @@
 #include <utility>
 #include <vector>
 
-#include <diff_rigid_body/Backprop.h>
-#include <diff_rigid_body/ForwardDynamics.h>
-#include <diff_rigid_body/GetBodies.h>
-#include <diff_rigid_body/GetCenterOfMass.h>
-#include <diff_rigid_body/GetFrameJacobians.h>
-#include <diff_rigid_body/GetMassMatrix.h>
-#include <diff_rigid_body/GetVertexJacobians.h>
-#include <diff_rigid_body/GetVertexJacobiansCompact.h>
-#include <diff_rigid_body/InverseDynamics.h>
+#include "diff_rigid_body/services/service_tables.h"  // generated from srv/*.srv
+#include "diff_rigid_body_ros/services.h"
 
 namespace diff_rigid_body_ros
 {
 namespace pool
 {
+/// The registry's name (services.h) of each srv type.
+template <typename Service>
+struct ServiceName;
+#define DRB_POOL_SERVICE_NAME(name, type, ...)                                                                         \
+  template <>                                                                                                          \
+  struct ServiceName<diff_rigid_body::type>                                                                            \
+  {                                                                                                                    \
+    static constexpr const char* value = #name;                                                                        \
+  };
+DIFF_RIGID_BODY_SERVICES(DRB_POOL_SERVICE_NAME)
+#undef DRB_POOL_SERVICE_NAME
+
 /// Per sharded service: its name, the request fields that hold K runs (an empty field, e.g. qdot =
-/// zeros, stays empty in every shard) and the response fields that do, as member pointers.
+/// zeros, stays empty in every shard) and the response fields that do, as member pointers: the
+/// fields whose comment in the .srv begins with "[per configuration]" (DRB_SHARDED_SERVICES).
 template <typename Service>
 struct Sharding;
 
-#define DRB_POOL_SHARDING(Type, name, request_fields, response_fields)                                                \
+#define DRB_POOL_SHARDING(Type, request_fields, response_fields)                                                      \
   template <>                                                                                                          \
   struct Sharding<diff_rigid_body::Type>                                                                               \
   {                                                                                                                    \
     using Request = diff_rigid_body::Type::Request;                                                                    \
     using Response = diff_rigid_body::Type::Response;                                                                  \
-    static constexpr const char* service = name;                                                                       \
+    static constexpr const char* service = ServiceName<diff_rigid_body::Type>::value;                                  \
     static auto requestFields() { return std::make_tuple request_fields; }                                            \
     static auto responseFields() { return std::make_tuple response_fields; }                                          \
   };
-DRB_POOL_SHARDING(GetMassMatrix, "get_mass_matrix", (&Request::q),
-                  (&Response::mass_matrices, &Response::derivatives, &Response::cos_theta))
-DRB_POOL_SHARDING(GetVertexJacobians, "get_vertex_jacobians", (&Request::q),
-                  (&Response::positions, &Response::jacobians))
-DRB_POOL_SHARDING(GetVertexJacobiansCompact, "get_vertex_jacobians_compact", (&Request::q),
-                  (&Response::positions, &Response::rotation_jacobians, &Response::positions_f32,
-                   &Response::rotation_jacobians_f32))
-DRB_POOL_SHARDING(Backprop, "backprop", (&Request::q, &Request::gradients), (&Response::gradient))
-DRB_POOL_SHARDING(InverseDynamics, "inverse_dynamics", (&Request::q, &Request::qdot, &Request::qddot),
-                  (&Response::tau, &Response::velocity_terms, &Response::gravity_terms, &Response::coriolis_matrices,
-                   &Response::dtau_dq, &Response::dtau_dqdot, &Response::cos_theta))
-DRB_POOL_SHARDING(ForwardDynamics, "forward_dynamics", (&Request::q, &Request::qdot, &Request::tau),
-                  (&Response::qddot, &Response::dqddot_dq, &Response::dqddot_dqdot, &Response::dqddot_dtau,
-                   &Response::cos_theta))
-DRB_POOL_SHARDING(GetFrameJacobians, "get_frame_jacobians", (&Request::q, &Request::qdot),
-                  (&Response::poses, &Response::jacobians, &Response::acceleration_bias, &Response::cos_theta))
-DRB_POOL_SHARDING(GetCenterOfMass, "get_center_of_mass", (&Request::q, &Request::qdot),
-                  (&Response::com, &Response::jacobians, &Response::acceleration_bias, &Response::cos_theta))
+DRB_SHARDED_SERVICES(DRB_POOL_SHARDING)
 #undef DRB_POOL_SHARDING
 
 /// The scene's d per body name, and its body order (an empty `bodies` field means all of them).

@@ -1,5 +1,5 @@
 """How :class:`~diff_rigid_body.pool.RigidBodyPool` cuts a K-configuration request into contiguous
-shards and joins the answers, apart from the service calls (numpy only).
+shards and joins the answers, apart from the service calls.
 
 Every sharded field travels configuration-major (configuration k's values are one contiguous run
 of the same length for every k), so a shard of configurations [start, stop) is a slice of each
@@ -11,23 +11,23 @@ import collections
 
 import numpy as np
 
+from diff_rigid_body.client import RigidBodyClient
+from diff_rigid_body.service_fields import parse_fields, per_configuration
+
 #: Per sharded service: the request fields that hold K runs (one per configuration; an empty
-#: field, e.g. qdot = zeros, stays empty in every shard) and the response fields that do.
+#: field, e.g. qdot = zeros, stays empty in every shard) and the response fields that do: the
+#: fields whose comment in the .srv begins with "[per configuration]" (``service_fields``).
 Sharding = collections.namedtuple('Sharding', 'request response')
-SHARDED = {
-    'get_mass_matrix': Sharding(('q',), ('mass_matrices', 'derivatives', 'cos_theta')),
-    'get_vertex_jacobians': Sharding(('q',), ('positions', 'jacobians')),
-    'get_vertex_jacobians_compact': Sharding(('q',), ('positions', 'rotation_jacobians', 'positions_f32',
-                                                     'rotation_jacobians_f32')),
-    'backprop': Sharding(('q', 'gradients'), ('gradient',)),
-    'inverse_dynamics': Sharding(('q', 'qdot', 'qddot'), ('tau', 'velocity_terms', 'gravity_terms',
-                                                          'coriolis_matrices', 'dtau_dq', 'dtau_dqdot',
-                                                          'cos_theta')),
-    'forward_dynamics': Sharding(('q', 'qdot', 'tau'), ('qddot', 'dqddot_dq', 'dqddot_dqdot', 'dqddot_dtau',
-                                                        'cos_theta')),
-    'get_frame_jacobians': Sharding(('q', 'qdot'), ('poses', 'jacobians', 'acceleration_bias', 'cos_theta')),
-    'get_center_of_mass': Sharding(('q', 'qdot'), ('com', 'jacobians', 'acceleration_bias', 'cos_theta')),
-}
+
+
+def _sharding(service_class):
+    request, response = (per_configuration(parse_fields(part._full_text))
+                         for part in (service_class._request_class, service_class._response_class))
+    return Sharding(request, response) if request else None
+
+
+SHARDED = {name: _sharding(service_class) for name, service_class in RigidBodyClient.SERVICES.items()
+           if _sharding(service_class)}
 
 
 def configuration_count(name, message, dofs):

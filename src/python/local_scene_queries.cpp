@@ -72,7 +72,7 @@ py::dict LocalScene::getBodies() const
   BodiesAnswer answer;
   serve("get_bodies", [&] { answer = describeBodies(queries_->scene()); });
   py::dict r;
-  DRB_BODIES_ANSWER_FIELDS(DRB_PYTHON_FIELD)
+  DRB_GetBodies_RESPONSE_FIELDS(DRB_PYTHON_FIELD)
   return r;
 }
 
@@ -83,7 +83,7 @@ py::dict LocalScene::getMassMatrix(const std::vector<std::string>& bodies, const
   MassMatrixAnswer answer;
   serve("get_mass_matrix", [&] { queries_->massMatrices(state_, bodies, x.view(), derivatives, answer); });
   py::dict r;
-  DRB_MASS_MATRIX_ANSWER_FIELDS(DRB_PYTHON_FIELD)
+  DRB_GetMassMatrix_RESPONSE_FIELDS(DRB_PYTHON_FIELD)
   return r;
 }
 
@@ -150,7 +150,7 @@ py::dict LocalScene::inverseDynamics(const std::vector<std::string>& bodies, con
                               answer);
   });
   py::dict r;
-  DRB_INVERSE_DYNAMICS_ANSWER_FIELDS(DRB_PYTHON_FIELD)
+  DRB_InverseDynamics_RESPONSE_FIELDS(DRB_PYTHON_FIELD)
   return r;
 }
 
@@ -164,7 +164,7 @@ py::dict LocalScene::forwardDynamics(const std::vector<std::string>& bodies, con
     queries_->forwardDynamics(state_, bodies, x.view(), v.view(), t.view(), derivatives, answer);
   });
   py::dict r;
-  DRB_FORWARD_DYNAMICS_ANSWER_FIELDS(DRB_PYTHON_FIELD)
+  DRB_ForwardDynamics_RESPONSE_FIELDS(DRB_PYTHON_FIELD)
   return r;
 }
 
@@ -178,7 +178,7 @@ py::dict LocalScene::getFrameJacobians(const std::string& body, const std::vecto
     queries_->frameJacobians(state_, body, frames, x.view(), v.view(), reference, acceleration_bias, answer);
   });
   py::dict r;
-  DRB_FRAME_JACOBIAN_ANSWER_FIELDS(DRB_PYTHON_FIELD)
+  DRB_GetFrameJacobians_RESPONSE_FIELDS(DRB_PYTHON_FIELD)
   return r;
 }
 
@@ -190,7 +190,7 @@ py::dict LocalScene::getCenterOfMass(const std::vector<std::string>& bodies, con
   serve("get_center_of_mass",
         [&] { queries_->centerOfMass(state_, bodies, x.view(), v.view(), jacobians, answer); });
   py::dict r;
-  DRB_CENTER_OF_MASS_ANSWER_FIELDS(DRB_PYTHON_FIELD)
+  DRB_GetCenterOfMass_RESPONSE_FIELDS(DRB_PYTHON_FIELD)
   return r;
 }
 

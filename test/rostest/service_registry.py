@@ -5,7 +5,7 @@ everything that must agree with it (service_registry.test):
 - the running node advertises exactly the registry's services: without
   ~benchmark_services the others, with it all of them;
 - every srv type is a file in srv/, listed in CMakeLists.txt's
-  add_service_files and included by services.h;
+  DRB_SERVICE_FILES (add_service_files and service_tables.h) and included by services.h;
 - the Python client (RigidBodyClient) has each service in SERVICES, with its
   srv type, and a method that calls it;
 - the C++ client header declares each C++ method, and calls the service with
@@ -15,9 +15,10 @@ everything that must agree with it (service_registry.test):
   Python client's method table and one for each C++ method in the C++ one.
 A service without a client method (`none`) must be benchmark-only.
 Every service that takes K configurations (a request field `float64[] q`) is in both pools'
-sharding tables (pool_shards.py, pool_shards.h), sharding every float array of its request and
-every per-configuration float array of its answer: a service left out would silently stop being
-split across instances.
+sharding tables (pool_shards.py from the srv classes, service_tables.h generated from srv/*.srv),
+sharding every float array of its request and every per-configuration float array of its answer:
+a .srv field without its "[per configuration]" marker would silently stop being split across
+instances.
 GetBodies.srv and BodyState.msg comment every field in the user's terms, `rossrv show -r` prints the
 comments, and README.md names that command.
 """
@@ -43,12 +44,22 @@ ROSCPP_SERVICES = {'get_loggers', 'set_logger_level'}  # roscpp's own, on every 
 
 ENTRY = re.compile(r'^\s*X\(\s*(\w+)\s*,\s*(\w+)\s*,\s*(\w+)\s*,\s*(\w+)\s*,\s*(\w+)\s*,\s*(true|false)\s*\)', re.M)
 FIELDS = ('name', 'srv_type', 'handler', 'python_method', 'cpp_method', 'benchmark_only')
-CPP_SHARDING = re.compile(r'DRB_POOL_SHARDING\(\s*\w+\s*,\s*"(\w+)"\s*,\s*\(([^)]*)\)\s*,\s*\(([^)]*)\)\)')
+CPP_SHARDING = re.compile(r'X\((\w+), \(([^)]*)\), \(([^)]*)\)\)')  # DRB_SHARDED_SERVICES' rows
 PER_BODY_FIELDS = {'masses'}  # answer arrays of one value per body, the same in every shard
 
 
 def package_file(*parts):
     return os.path.join(rospkg.RosPack().get_path(PKG), *parts)
+
+
+def generated_service_tables():
+    """The text of service_tables.h, generated from srv/*.srv into the devel (or install) space."""
+    for prefix in os.environ.get('CMAKE_PREFIX_PATH', '').split(os.pathsep):
+        path = os.path.join(prefix, 'include', PKG, 'services', 'service_tables.h')
+        if prefix and os.path.isfile(path):
+            with open(path) as f:
+                return f.read()
+    raise AssertionError('service_tables.h is in no include/%s/services of CMAKE_PREFIX_PATH' % PKG)
 
 
 def read(*parts):
@@ -137,12 +148,12 @@ class ServiceRegistry(unittest.TestCase):
 
     def test_srv_files(self):
         cmake = read('CMakeLists.txt')
-        listed = ' '.join(re.findall(r'add_service_files\(FILES([^)]*)\)', cmake)).split()
+        listed = ' '.join(re.findall(r'set\(DRB_SERVICE_FILES([^)]*)\)', cmake)).split()
         header = read('include', 'diff_rigid_body_ros', 'services.h')
         for e in self.entries:
             srv = e['srv_type'] + '.srv'
             self.assertTrue(os.path.isfile(package_file('srv', srv)), '%s: srv/%s does not exist' % (e['name'], srv))
-            self.assertIn(srv, listed, '%s: %s is not in add_service_files (CMakeLists.txt)' % (e['name'], srv))
+            self.assertIn(srv, listed, '%s: %s is not in DRB_SERVICE_FILES (CMakeLists.txt)' % (e['name'], srv))
             self.assertIn('#include <diff_rigid_body/%s.h>' % e['srv_type'], header,
                           'services.h does not include the srv header of %s' % e['name'])
 
@@ -181,9 +192,9 @@ class ServiceRegistry(unittest.TestCase):
                             % (e['srv_type'], e['name']))
 
     def test_pools_shard_every_batched_service(self):
-        cpp = {name: (set(re.findall(r'&Request::(\w+)', request)), set(re.findall(r'&Response::(\w+)', response)))
-               for name, request, response in CPP_SHARDING.findall(read('include', 'diff_rigid_body_ros',
-                                                                        'pool_shards.h'))}
+        names = {e['srv_type']: e['name'] for e in self.entries}
+        cpp = {names[srv]: (set(re.findall(r'&Request::(\w+)', request)), set(re.findall(r'&Response::(\w+)', response)))
+               for srv, request, response in CPP_SHARDING.findall(generated_service_tables())}
         python = {name: (set(s.request), set(s.response)) for name, s in SHARDED.items()}
         batched = set()
         for e in self.entries:
@@ -193,10 +204,10 @@ class ServiceRegistry(unittest.TestCase):
                 continue
             batched.add(e['name'])
             wanted = (arrays[0], arrays[1] - PER_BODY_FIELDS)
-            for table, entries in (('pool_shards.py SHARDED', python), ('pool_shards.h', cpp)):
+            for table, entries in (('pool_shards.py SHARDED', python), ('service_tables.h', cpp)):
                 self.assertIn(e['name'], entries, '%s: no sharding for %s' % (table, e['name']))
                 self.assertEqual(entries[e['name']], wanted, '%s: the sharded fields of %s' % (table, e['name']))
-        for table, entries in (('pool_shards.py SHARDED', python), ('pool_shards.h', cpp)):
+        for table, entries in (('pool_shards.py SHARDED', python), ('service_tables.h', cpp)):
             self.assertEqual(set(entries) - batched, set(), '%s shards services without a q' % table)
 
     def test_readme_services_table(self):

@@ -24,27 +24,9 @@ namespace diff_rigid_body
 /// body after body in vertex order, with link_counts per body and per link its
 /// vertices, mass, inertia about its COM in link axes (9) and COM in its own
 /// frame (3).
-#define DRB_BODIES_ANSWER_FIELDS(X)                                                                                    \
-  X(std::string, fixed_frame)                                                                                          \
-  X(std::vector<std::string>, names)                                                                                   \
-  X(std::vector<double>, masses)                                                                                       \
-  X(std::vector<double>, inertias)                                                                                     \
-  X(std::vector<double>, com_offsets)                                                                                  \
-  X(std::vector<std::uint32_t>, vertex_counts)                                                                         \
-  X(std::vector<std::uint32_t>, dofs)                                                                                  \
-  X(std::vector<std::string>, joint_names)                                                                             \
-  X(std::vector<std::uint32_t>, joint_counts)                                                                          \
-  X(std::vector<double>, joint_lower)                                                                                  \
-  X(std::vector<double>, joint_upper)                                                                                  \
-  X(std::vector<std::string>, link_names)                                                                              \
-  X(std::vector<std::uint32_t>, link_counts)                                                                           \
-  X(std::vector<std::uint32_t>, link_vertex_counts)                                                                    \
-  X(std::vector<double>, link_masses)                                                                                  \
-  X(std::vector<double>, link_inertias)                                                                                \
-  X(std::vector<double>, link_com_offsets)
 struct BodiesAnswer
 {
-  DRB_ANSWER(DRB_BODIES_ANSWER_FIELDS)
+  DRB_ANSWER(DRB_GetBodies_RESPONSE_FIELDS)
 };
 
 /// The answer for every body of `scene`.

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "diff_rigid_body/services/array_view.h"
+#include "diff_rigid_body/services/service_tables.h"  // generated from srv/*.srv
 #include "diff_rigid_body/multibody/body_workspace.h"
 #include "diff_rigid_body/parsers/urdf_scene.h"
 #include "diff_rigid_body/algorithm/vertex_jacobians.h"
@@ -61,11 +62,12 @@ struct NamedState
   Eigen::VectorXd x = Eigen::VectorXd::Zero(6);
 };
 
-// The batched answers, each declared from one list of its fields,
-// X(type, name), named and ordered as in its .srv response. DRB_ANSWER
+// The batched answers, each declared from its .srv response's fields:
+// DRB_<Type>_RESPONSE_FIELDS(X), X(type, name) in the response's order, is
+// written from srv/<Type>.srv at configure time (service_tables.h). DRB_ANSWER
 // declares the fields and moveInto(response), which moves each field into the
 // member of the same name of any struct that has them (the node's srv
-// response): a field is named once, here, for the core and the node.
+// response): a field is named once, in its .srv, for the core and the node.
 #define DRB_ANSWER_FIELD(type, name) type name{};
 #define DRB_ANSWER_MOVE(type, name) response.name = std::move(name);
 #define DRB_ANSWER(FIELDS)                                                                                             \
@@ -82,15 +84,9 @@ struct NamedState
 /// d_i^3 per matrix when asked, dM/dx_j for j = 0..d_i-1, d_i^2 row-major
 /// each; cos_theta: one per matrix, cos(theta) of a free body or floating
 /// root (0 at gimbal lock), 1 for a fixed-base body (no Euler angles).
-#define DRB_MASS_MATRIX_ANSWER_FIELDS(X)                                                                               \
-  X(std::vector<std::string>, bodies)                                                                                  \
-  X(std::vector<std::uint32_t>, dofs)                                                                                  \
-  X(std::vector<double>, mass_matrices)                                                                                \
-  X(std::vector<double>, derivatives)                                                                                  \
-  X(std::vector<double>, cos_theta)
 struct MassMatrixAnswer
 {
-  DRB_ANSWER(DRB_MASS_MATRIX_ANSWER_FIELDS)
+  DRB_ANSWER(DRB_GetMassMatrix_RESPONSE_FIELDS)
 };
 
 /// ~inverse_dynamics, laid out as MassMatrixAnswer: per configuration k and
@@ -99,35 +95,17 @@ struct MassMatrixAnswer
 /// tau = M x'' + c + g, velocity_terms c = C x', gravity_terms g; when asked,
 /// coriolis_matrices C, dtau_dq and dtau_dqdot (= 2 C); cos_theta per
 /// matrix slot, as MassMatrixAnswer.
-#define DRB_INVERSE_DYNAMICS_ANSWER_FIELDS(X)                                                                          \
-  X(std::vector<std::string>, bodies)                                                                                  \
-  X(std::vector<std::uint32_t>, dofs)                                                                                  \
-  X(std::vector<double>, tau)                                                                                          \
-  X(std::vector<double>, velocity_terms)                                                                               \
-  X(std::vector<double>, gravity_terms)                                                                                \
-  X(std::vector<double>, coriolis_matrices)                                                                            \
-  X(std::vector<double>, dtau_dq)                                                                                      \
-  X(std::vector<double>, dtau_dqdot)                                                                                   \
-  X(std::vector<double>, cos_theta)
 struct InverseDynamicsAnswer
 {
-  DRB_ANSWER(DRB_INVERSE_DYNAMICS_ANSWER_FIELDS)
+  DRB_ANSWER(DRB_InverseDynamics_RESPONSE_FIELDS)
 };
 
 /// ~forward_dynamics, laid out as InverseDynamicsAnswer: qddot =
 /// M^-1 (tau - c - g); when asked dqddot_dq, dqddot_dqdot and dqddot_dtau
 /// (= M^-1).
-#define DRB_FORWARD_DYNAMICS_ANSWER_FIELDS(X)                                                                          \
-  X(std::vector<std::string>, bodies)                                                                                  \
-  X(std::vector<std::uint32_t>, dofs)                                                                                  \
-  X(std::vector<double>, qddot)                                                                                        \
-  X(std::vector<double>, dqddot_dq)                                                                                    \
-  X(std::vector<double>, dqddot_dqdot)                                                                                 \
-  X(std::vector<double>, dqddot_dtau)                                                                                  \
-  X(std::vector<double>, cos_theta)
 struct ForwardDynamicsAnswer
 {
-  DRB_ANSWER(DRB_FORWARD_DYNAMICS_ANSWER_FIELDS)
+  DRB_ANSWER(DRB_ForwardDynamics_RESPONSE_FIELDS)
 };
 
 /// ~get_frame_jacobians: per configuration k and listed frame f
@@ -136,16 +114,9 @@ struct ForwardDynamicsAnswer
 /// row-major; jacobians: 6 d per slot, row-major, rows linear then angular;
 /// acceleration_bias: 6 per slot, when asked; cos_theta: one per
 /// configuration, as MassMatrixAnswer.
-#define DRB_FRAME_JACOBIAN_ANSWER_FIELDS(X)                                                                            \
-  X(std::vector<std::string>, frames)                                                                                  \
-  X(std::uint32_t, dofs)                                                                                               \
-  X(std::vector<double>, poses)                                                                                        \
-  X(std::vector<double>, jacobians)                                                                                    \
-  X(std::vector<double>, acceleration_bias)                                                                            \
-  X(std::vector<double>, cos_theta)
 struct FrameJacobianAnswer
 {
-  DRB_ANSWER(DRB_FRAME_JACOBIAN_ANSWER_FIELDS)
+  DRB_ANSWER(DRB_GetFrameJacobians_RESPONSE_FIELDS)
 };
 
 /// ~get_center_of_mass: per configuration k and listed body i (body-major
@@ -153,17 +124,9 @@ struct FrameJacobianAnswer
 /// [kg]; com: 3 per slot, fixed frame [m]; when asked, jacobians (3 d_i per
 /// slot, row-major) and acceleration_bias (3 per slot [m/s^2]); cos_theta
 /// per slot.
-#define DRB_CENTER_OF_MASS_ANSWER_FIELDS(X)                                                                            \
-  X(std::vector<std::string>, bodies)                                                                                  \
-  X(std::vector<std::uint32_t>, dofs)                                                                                  \
-  X(std::vector<double>, masses)                                                                                       \
-  X(std::vector<double>, com)                                                                                          \
-  X(std::vector<double>, jacobians)                                                                                    \
-  X(std::vector<double>, acceleration_bias)                                                                            \
-  X(std::vector<double>, cos_theta)
 struct CenterOfMassAnswer
 {
-  DRB_ANSWER(DRB_CENTER_OF_MASS_ANSWER_FIELDS)
+  DRB_ANSWER(DRB_GetCenterOfMass_RESPONSE_FIELDS)
 };
 
 /// Standard gravity in the fixed frame, -9.81 m/s^2 along z (~gravity's default).
