@@ -5,16 +5,17 @@
 // DIFF_RIGID_BODY_SERVICES(X) calls X once per service, with
 //   name            the service's name in the node's private namespace (~name)
 //   srv type        diff_rigid_body::<type>, from srv/<type>.srv
-//   node handler    RigidBodyServer::<handler> (src/node/rigid_body_server.h)
+//   node handler    RigidBodyServer::<handler> (src/node/rigid_body_server.h): the name in camelCase
 //   python method   RigidBodyClient.<method> (src/diff_rigid_body/client.py)
 //   C++ method      diff_rigid_body_ros::RigidBodyClient::<method> (rigid_body_client.h)
 //   benchmark only  true: advertised only with ~benchmark_services:=true
 // A client method of `none` means that no client wraps the service; only a
 // benchmark-only service may have none.
 //
-// Adding a service: see docs/architecture.md ("Adding a service"). One entry
-// per line, in the form below: the test reads this file with a regular
-// expression.
+// The list is written at configure time (cmake/service_tables.py) from the
+// first line of each .srv of DRB_SERVICE_FILES (CMakeLists.txt), e.g.
+//   # [service] ~get_mass_matrix; Python: mass_matrix; C++: massMatrices
+// Adding a service: see docs/architecture.md ("Adding a service").
 #pragma once
 
 #include <diff_rigid_body/Backprop.h>
@@ -31,20 +32,4 @@
 #include <diff_rigid_body/Ping.h>
 #include <diff_rigid_body/SetState.h>
 
-// clang-format off
-#define DIFF_RIGID_BODY_SERVICES(X)                                                                                    \
-  /* name                          srv type                   node handler               python method             C++ method              benchmark only */ \
-  X(get_bodies,                    GetBodies,                 getBodies,                 bodies,                   bodies,                 false) \
-  X(set_state,                     SetState,                  setState,                  set_state,                setState,               false) \
-  X(get_state,                     GetState,                  getState,                  get_state,                getState,               false) \
-  X(get_mass_matrix,               GetMassMatrix,             getMassMatrix,             mass_matrix,              massMatrices,           false) \
-  X(get_vertex_jacobians,          GetVertexJacobians,        getVertexJacobians,        vertex_jacobians,         vertexJacobians,        false) \
-  X(backprop,                      Backprop,                  backprop,                  backprop,                 backprop,               false) \
-  X(get_vertex_jacobians_compact,  GetVertexJacobiansCompact, getVertexJacobiansCompact, vertex_jacobians_compact, vertexJacobiansCompact, false) \
-  X(inverse_dynamics,              InverseDynamics,           inverseDynamics,           inverse_dynamics,         inverseDynamics,        false) \
-  X(forward_dynamics,              ForwardDynamics,           forwardDynamics,           forward_dynamics,         forwardDynamics,        false) \
-  X(get_frame_jacobians,           GetFrameJacobians,         getFrameJacobians,         frame_jacobians,          frameJacobians,         false) \
-  X(get_center_of_mass,            GetCenterOfMass,           getCenterOfMass,           center_of_mass,           centerOfMass,           false) \
-  X(ping,                          Ping,                      ping,                      none,                     none,                   true)  \
-  X(echo,                          Echo,                      echo,                      none,                     none,                   true)
-// clang-format on
+#include "diff_rigid_body/services/service_tables.h"  // DIFF_RIGID_BODY_SERVICES, generated from srv/*.srv

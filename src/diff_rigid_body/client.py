@@ -1,7 +1,7 @@
 """A numpy client for rigid_body_server.
 
-Wraps the node's services (those of include/diff_rigid_body_ros/services.h
-that have a client method) with persistent connections and returns numpy
+Wraps the node's services (those whose .srv declares a Python method,
+``diff_rigid_body.service_fields``) with persistent connections and returns numpy
 arrays, with no per-element Python loop either way: a request's numeric
 arrays are flat numpy buffers of their wire type (``client_arrays.wire_message``)
 written to the socket as they are, and a response's arrays are
@@ -77,9 +77,9 @@ from diff_rigid_body.client_names import NodeNotFoundError, body_names, missing_
 from diff_rigid_body.client_queries import SceneQueries
 from diff_rigid_body.client_types import (Bodies, DiffRigidBodyError, ForwardDynamicsResult,
                                          InverseDynamicsResult, Joint, Link, MassMatrices)
+from diff_rigid_body import srv
 from diff_rigid_body.msg import BodyState
-from diff_rigid_body.srv import (Backprop, ForwardDynamics, GetBodies, GetCenterOfMass, GetFrameJacobians, GetMassMatrix,
-                                 GetState, GetVertexJacobians, GetVertexJacobiansCompact, InverseDynamics, SetState)
+from diff_rigid_body.service_fields import declared_services
 from diff_rigid_body.tcpros import ServiceConnection
 
 __all__ = ['DiffRigidBodyError', 'RigidBodyClient', 'Bodies', 'Joint', 'Link', 'MassMatrices', 'InverseDynamicsResult',
@@ -119,19 +119,9 @@ class RigidBodyClient(SceneQueries):
     ``rospy.init_node`` is not required for calls.
     """
 
-    SERVICES = {
-        'get_bodies': GetBodies,
-        'set_state': SetState,
-        'get_state': GetState,
-        'get_mass_matrix': GetMassMatrix,
-        'get_vertex_jacobians': GetVertexJacobians,
-        'backprop': Backprop,
-        'get_vertex_jacobians_compact': GetVertexJacobiansCompact,
-        'inverse_dynamics': InverseDynamics,
-        'forward_dynamics': ForwardDynamics,
-        'get_frame_jacobians': GetFrameJacobians,
-        'get_center_of_mass': GetCenterOfMass,
-    }
+    #: service name -> srv class: the services whose .srv declares a Python method (``service_fields``).
+    SERVICES = {name: service_class for name, (service_class, declaration) in declared_services(srv).items()
+                if declaration.python}
 
     def __init__(self, server='rigid_body_server', timeout=30.0, reconnect=True, transport='tcpros'):
         if transport not in ('tcpros', 'rospy'):

@@ -1,5 +1,15 @@
-"""The fields of a service, read from its .srv text: the one declaration of what a request and
-its answer hold, and of which of their arrays run over the K configurations of a batched call.
+"""A service's one declaration, read from its .srv text: its name and client methods, what a
+request and its answer hold, and which of their arrays run over the K configurations of a batched
+call.
+
+The first line names the service and the methods that wrap it:
+
+    # [service] ~get_mass_matrix; Python: mass_matrix; C++: massMatrices
+    # [service] ~ping; benchmark only (advertised with ~benchmark_services:=true)
+
+The node advertises every declared service (``DIFF_RIGID_BODY_SERVICES`` in ``services.h``, from
+``service_tables.h``), the Python client holds those with a Python method in its ``SERVICES``, and
+the node's handler is the name in camelCase (``getMassMatrix``).
 
 A field whose comment begins with ``[per configuration]`` holds configuration k's values as one
 contiguous run of the same length for every k (configuration-major), so that configurations
@@ -14,7 +24,8 @@ Standard library only: the build runs this module before the package exists.
 import collections
 import re
 
-__all__ = ['Field', 'PER_CONFIGURATION', 'parse_fields', 'parse_service', 'per_configuration']
+__all__ = ['Declaration', 'Field', 'PER_CONFIGURATION', 'declared_services', 'parse_declaration', 'parse_fields',
+           'parse_service', 'per_configuration']
 
 #: The marker that opens a per-configuration field's comment.
 PER_CONFIGURATION = '[per configuration]'
@@ -22,7 +33,34 @@ PER_CONFIGURATION = '[per configuration]'
 #: One field: its ROS type (``float64[]``), name and whether it runs over the configurations.
 Field = collections.namedtuple('Field', 'type name per_configuration')
 
+#: A service's name (without ~), its Python and C++ client methods (None: benchmark only).
+Declaration = collections.namedtuple('Declaration', 'name python cpp benchmark_only')
+
+_DECLARATION = re.compile(r'^#\s*\[service\]\s*~(\w+)\s*;\s*(?:Python:\s*(\w+)\s*;\s*C\+\+:\s*(\w+)|(benchmark only))')
 _FIELD = re.compile(r'^\s*([A-Za-z_][\w/]*(?:\[\d*\])?)\s+([A-Za-z_]\w*)\s*(?:#\s*(.*))?$')
+
+
+def parse_declaration(text):
+    """The :data:`Declaration` on the first line of a .srv text (or of a request's
+    ``_full_text``), or None when it has none."""
+    match = _DECLARATION.match(text.lstrip())
+    if match is None:
+        return None
+    name, python, cpp, benchmark_only = match.groups()
+    return Declaration(name, python, cpp, benchmark_only is not None)
+
+
+def declared_services(srv_module):
+    """name -> (srv class, :data:`Declaration`) of every service class of ``srv_module`` (the
+    generated ``diff_rigid_body.srv``) whose .srv declares it, in name order."""
+    services = {}
+    for attribute in sorted(dir(srv_module)):
+        service_class = getattr(srv_module, attribute)
+        request = getattr(service_class, '_request_class', None)
+        declaration = parse_declaration(request._full_text) if request is not None else None
+        if declaration is not None:
+            services[declaration.name] = (service_class, declaration)
+    return services
 
 
 def parse_fields(part):

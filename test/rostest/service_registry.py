@@ -1,6 +1,7 @@
 #!/usr/bin/python3
-"""The service registry (include/diff_rigid_body_ros/services.h) against
-everything that must agree with it (service_registry.test):
+"""The service registry (DIFF_RIGID_BODY_SERVICES of include/diff_rigid_body_ros/services.h, written
+from the first line of each .srv into service_tables.h) against everything that must agree with it
+(service_registry.test):
 
 - the running node advertises exactly the registry's services: without
   ~benchmark_services the others, with it all of them;
@@ -68,9 +69,11 @@ def read(*parts):
 
 
 def registry():
-    """The entries of DIFF_RIGID_BODY_SERVICES, as dicts, in order."""
-    text = read('include', 'diff_rigid_body_ros', 'services.h')
+    """The entries of DIFF_RIGID_BODY_SERVICES (services.h, from the generated service_tables.h), as
+    dicts, in order."""
+    text = generated_service_tables()
     body = text[text.index('#define DIFF_RIGID_BODY_SERVICES'):]
+    body = body[:body.index('\n\n')]
     entries = [dict(zip(FIELDS, match)) for match in ENTRY.findall(body)]
     for entry in entries:
         entry['benchmark_only'] = entry['benchmark_only'] == 'true'
