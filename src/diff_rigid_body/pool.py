@@ -25,7 +25,6 @@ instance; ``get_state`` asks one instance and ``set_state`` sets every live one 
 is down meanwhile keeps its old state: pass q explicitly to a pool). Not thread-safe: one pool per
 thread (it runs one worker thread per instance).
 """
-import socket
 import time
 
 import numpy as np
@@ -35,6 +34,7 @@ from diff_rigid_body.client import CONNECTION_ERRORS, DiffRigidBodyError, RigidB
 from diff_rigid_body.client_names import body_names, pool_node_name
 from diff_rigid_body.pool_shards import JoinedResponse, apportion, configuration_count, shard_message
 from diff_rigid_body.pool_threads import Worker, wait_all
+from diff_rigid_body.tcpros import shut_down
 
 __all__ = ['RigidBodyPool', 'PoolError', 'scene_mismatch']
 
@@ -93,12 +93,7 @@ class _Instance(object):
             if hasattr(proxy, 'interrupt'):
                 proxy.interrupt()
                 continue
-            sock = getattr(getattr(proxy, 'transport', None), 'socket', None)
-            if sock is not None:
-                try:
-                    sock.shutdown(socket.SHUT_RDWR)
-                except OSError:
-                    pass
+            shut_down(getattr(getattr(proxy, 'transport', None), 'socket', None))
 
 
 class RigidBodyPool(RigidBodyClient):

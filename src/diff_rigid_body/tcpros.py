@@ -23,7 +23,7 @@ import rosgraph
 import rosgraph.network
 import rospy
 
-__all__ = ['ServiceConnection']
+__all__ = ['ServiceConnection', 'shut_down']
 
 _LENGTH = struct.Struct('<I')
 _ANSWER_HEAD = struct.Struct('<BI')  # ok byte, answer length
@@ -62,6 +62,16 @@ class _Received(np.ndarray):
 
     def decode(self, *args):
         return self.tobytes().decode(*args)
+
+
+def shut_down(sock):
+    """Shuts ``sock`` down both ways, so that a call blocked on it in another thread raises (None or
+    an already closed socket: nothing to do)."""
+    if sock is not None:
+        try:
+            sock.shutdown(socket.SHUT_RDWR)
+        except OSError:
+            pass
 
 
 class ServiceConnection(object):
@@ -120,12 +130,7 @@ class ServiceConnection(object):
 
     def interrupt(self):
         """Unblocks a call in flight in another thread (it raises): shuts the socket down."""
-        sock = self.sock
-        if sock is not None:
-            try:
-                sock.shutdown(socket.SHUT_RDWR)
-            except OSError:
-                pass
+        shut_down(self.sock)
 
     def close(self):
         sock, self.sock = self.sock, None

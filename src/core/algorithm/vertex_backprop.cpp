@@ -32,11 +32,11 @@ void segmentGradientSums(const BodyModel& model, BodyWorkspace<double>& ws,
   for (std::size_t s = 0; s < model.segments.size(); ++s)
   {
     const Segment& segment = model.segments[s];
-    const detail::GradientSums12 sums = detail::gradientSums(
+    const VertexGradientSums sums(detail::gradientSums(
         all.from(segment.vertex_begin), detail::ByVertex{ gradients + 3 * std::size_t(segment.vertex_begin) },
-        segment.vertex_count);
-    ws.segment_sums[s].outer = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(sums.data());
-    ws.segment_sums[s].force << sums[9], sums[10], sums[11];
+        segment.vertex_count));
+    ws.segment_sums[s].outer = sums.W;
+    ws.segment_sums[s].force = sums.force;
   }
 }
 }  // namespace

@@ -25,14 +25,6 @@
 
 namespace diff_rigid_body
 {
-/// Sums of the backprop over some vertices: W = sum_i g_i p0_i^T, force = sum_i g_i.
-template <typename Scalar>
-struct VertexGradientSums
-{
-  Matrix3<Scalar> W = Matrix3<Scalar>::Zero();
-  Vector3<Scalar> force = Vector3<Scalar>::Zero();
-};
-
 /// Below this many vertices per thread a thread costs more than it saves
 /// (starting one is ~10-50 us; 2^16 vertices take ~100 us on one core).
 constexpr std::size_t kMinVerticesPerBackpropThread = std::size_t(1) << 16;
@@ -56,16 +48,12 @@ inline ByCoordinate byCoordinate(const VertexColumns<double>& columns)
 /// under kMinVerticesPerBackpropThread vertices per thread.
 ///
 /// \param gradients dL/dp, 3 per vertex in vertex order [any unit / m]
-inline VertexGradientSums<double> sumVertexGradients(const VertexColumns<double>& columns, const double* gradients,
-                                                     unsigned threads = 1)
+inline VertexGradientSums sumVertexGradients(const VertexColumns<double>& columns, const double* gradients,
+                                             unsigned threads = 1)
 {
   const std::size_t count = static_cast<std::size_t>(columns.rows());
-  const detail::GradientSums12 sums = detail::gradientSumsInChunks(detail::byCoordinate(columns), gradients, count,
-                                                                   detail::backpropChunks(count, threads));
-  VertexGradientSums<double> out;
-  out.W = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(sums.data());
-  out.force << sums[9], sums[10], sums[11];
-  return out;
+  return VertexGradientSums(detail::gradientSumsInChunks(detail::byCoordinate(columns), gradients, count,
+                                                         detail::backpropChunks(count, threads)));
 }
 
 /// dL/dq = sum_i J_i^T g_i over all vertices of a body stored by coordinate
@@ -74,7 +62,7 @@ inline VertexGradientSums<double> sumVertexGradients(const VertexColumns<double>
 inline Vector6<double> backpropagateVertexGradients(const BodyPose<double>& pose, const VertexColumns<double>& columns,
                                                     const double* gradients, unsigned threads = 1)
 {
-  const VertexGradientSums<double> sums = sumVertexGradients(columns, gradients, threads);
+  const VertexGradientSums sums = sumVertexGradients(columns, gradients, threads);
   return backpropFromSums(pose, sums.W, sums.force);
 }
 

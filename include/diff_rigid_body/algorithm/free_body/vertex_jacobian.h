@@ -106,11 +106,24 @@ Vector6<Scalar> backpropFromSums(const BodyPose<Scalar>& pose, const Matrix3<Sca
   return dL_dq;
 }
 
-/// dL/dq from the 12 sums of the double engine (detail/backprop_sums.h).
+/// The 12 sums of the double engine (detail/backprop_sums.h) over some vertices:
+/// W = sum_i g_i p0_i^T (the first nine, row-major) and force = sum_i g_i.
+struct VertexGradientSums
+{
+  explicit VertexGradientSums(const detail::GradientSums12& sums)
+    : W(Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(sums.data()))
+    , force(sums[9], sums[10], sums[11])
+  {
+  }
+  Matrix3<double> W;
+  Vector3<double> force;
+};
+
+/// dL/dq from the 12 sums of the double engine.
 inline Vector6<double> backpropFromSums(const BodyPose<double>& pose, const detail::GradientSums12& sums)
 {
-  const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> W(sums.data());
-  return backpropFromSums(pose, Matrix3<double>(W), Vector3<double>(sums[9], sums[10], sums[11]));
+  const VertexGradientSums split(sums);
+  return backpropFromSums(pose, split.W, split.force);
 }
 
 /// dL/dq = sum_i J_i^T g_i without forming J.
