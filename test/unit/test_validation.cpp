@@ -3,12 +3,14 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include "diff_rigid_body/exceptions.h"
 #include "diff_rigid_body/mass/mass_property_checks.h"
+#include "diff_rigid_body/services/scene_queries.h"
 #include "../support/expect_throws.h"
 
 using diff_rigid_body::InvalidInertiaError;
@@ -93,4 +95,39 @@ TEST(Validation, PrincipalMomentsObeyTriangleInequality)
       InvalidInertiaError, kProbe, "triangle inequality");
   // Just inside Drake's tolerance eps = 16 DBL_EPSILON max(1, trace/2) is accepted.
   EXPECT_NO_THROW(validateMassProperties("edge", 1.0, Eigen::Vector3d(1, 1, 2 + 8 * DBL_EPSILON).asDiagonal()));
+}
+
+// requireFinite (every request array and every answer): each non-finite value, at every
+// position of arrays of odd and even length, is refused by its index; the extreme finite values
+// pass. Oracle: std::isfinite, value by value.
+TEST(Validation, RequireFiniteRefusesEachNonFiniteValueByIndex)
+{
+  const double finite[] = { 0.0, -0.0, DBL_MAX, -DBL_MAX, DBL_MIN, std::numeric_limits<double>::denorm_min(), 1.5 };
+  const double bad[] = { std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+                         std::numeric_limits<double>::quiet_NaN(), -std::numeric_limits<double>::quiet_NaN(),
+                         std::numeric_limits<double>::signaling_NaN() };
+  for (std::size_t count = 0; count <= 9; ++count)
+  {
+    std::vector<double> values(count);
+    for (std::size_t i = 0; i < count; ++i)
+      values[i] = finite[i % (sizeof finite / sizeof finite[0])];
+    EXPECT_NO_THROW(diff_rigid_body::requireFinite(values.data(), count, "q")) << count;
+    for (std::size_t at = 0; at < count; ++at)
+      for (double value : bad)
+      {
+        std::vector<double> with_bad = values;
+        with_bad[at] = value;
+        ASSERT_FALSE(std::isfinite(with_bad[at]));
+        try
+        {
+          diff_rigid_body::requireFinite(with_bad.data(), count, "q");
+          ADD_FAILURE() << "accepted " << value << " at " << at << " of " << count;
+        }
+        catch (const diff_rigid_body::InvalidArgumentError& error)
+        {
+          EXPECT_NE(std::string(error.what()).find("q[" + std::to_string(at) + "]: not finite"), std::string::npos)
+              << error.what();
+        }
+      }
+  }
 }

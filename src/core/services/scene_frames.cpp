@@ -90,6 +90,40 @@ void frameSlots(const Scene& scene, std::size_t body_index, const std::vector<st
   }
 }
 
+/// This thread's reused buffers for frameJacobians: the listed frames' slots, and the segments
+/// whose placement they need. The needed segments are marked again only when the scene, the body,
+/// the frames' links or the acceleration bias (which needs every segment) change.
+class FrameScratch
+{
+public:
+  std::vector<FrameSlot> slots;
+  std::vector<std::size_t> indices;
+
+  const std::vector<char>& needed(std::uint64_t scene_id, std::size_t body_index, const BodyModel& body,
+                                  bool every_segment)
+  {
+    links_.clear();
+    for (const FrameSlot& slot : slots)
+      if (!slot.fixed)
+        links_.push_back(slot.index);
+    if (scene_id == scene_id_ && body_index == body_index_ && every_segment == every_segment_ && links_ == marked_)
+      return needed_;
+    needed_.assign(body.segments.size(), every_segment ? 1 : 0);
+    for (std::size_t link : links_)
+      markSupport(body, link, needed_);
+    scene_id_ = scene_id, body_index_ = body_index, every_segment_ = every_segment;
+    marked_ = links_;
+    return needed_;
+  }
+
+private:
+  std::vector<std::size_t> links_, marked_;
+  std::vector<char> needed_;
+  std::uint64_t scene_id_ = 0;
+  std::size_t body_index_ = 0;
+  bool every_segment_ = false;
+};
+
 FrameReference frameReference(std::uint32_t reference)
 {
   if (reference > 2)
@@ -121,12 +155,12 @@ void SceneQueries::frameJacobians(const SceneState& current, const std::string& 
 {
   const std::size_t index = bodyIndex(body_name, "body");
   const BodyModel& body = scene_.bodies[index];
-  thread_local std::vector<FrameSlot> slots;
-  frameSlots(scene_, index, frames, link_index_, slots);
+  thread_local FrameScratch scratch;
+  const std::vector<FrameSlot>& slots = scratch.slots;
+  frameSlots(scene_, index, frames, link_index_, scratch.slots);
   const FrameReference ref = frameReference(reference);
-  thread_local std::vector<std::size_t> indices;
-  indices.assign(1, index);
-  const detail::RequestLayout& layout = detail::requestLayout(*this, indices);
+  scratch.indices.assign(1, index);
+  const detail::RequestLayout& layout = detail::requestLayout(*this, scratch.indices);
   const std::size_t K = dynamicsConfigurations(layout, 1, q, { { "qdot", &qdot } });
   const std::size_t d = body.coordinates, F = slots.size();
   checkDynamicsBudget(K, F * (12 + 6 * d + (acceleration_bias ? 6 : 0)) + 1, true);
@@ -141,11 +175,8 @@ void SceneQueries::frameJacobians(const SceneState& current, const std::string& 
   answer.acceleration_bias.resize(acceleration_bias ? K * F * 6 : 0);
   answer.cos_theta.resize(K);
   BodyWorkspace<double>& ws = workspace(index);
-  thread_local std::vector<char> needed;  // without the bias: only the listed frames' paths
-  needed.assign(body.segments.size(), acceleration_bias ? 1 : 0);
-  for (const FrameSlot& slot : slots)
-    if (!slot.fixed)
-      markSupport(body, slot.index, needed);
+  // Without the bias, only the listed frames' paths to the root are placed.
+  const std::vector<char>& needed = scratch.needed(id_, index, body, acceleration_bias);
   for (std::size_t k = 0; k < K; ++k)
   {
     const double* x = q.empty() ? current[index].data() : q.data() + k * d;
