@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -53,6 +54,43 @@ TEST(StaticFrames, AStaticLinkAndTheFixedFrameHaveTheirPoseAndNoColumns)
     for (int i = 72; i < 108; ++i)
       moving += std::abs(answer.jacobians[i]);
     EXPECT_GT(moving, 1.0);
+  }
+}
+
+// Each thread keeps the resolution of its last request's body and frames: a request on another
+// scene with the same names, or with or without the acceleration bias, must still get the answer
+// a fresh thread (nothing kept) gets, bit for bit.
+TEST(StaticFrames, ARequestAfterAnotherSceneOrOptionGetsAFreshThreadsAnswer)
+{
+  // Another scene with the same names, the table higher and after a floor (so its static index differs).
+  const std::string higher_table =
+      robot(link("floor", collision(boxGeometry("2 2 0.1"))) + link("table", collision(boxGeometry("1 1 1"))) +
+            link("box", inertial()) + joint("fixed", "world", "floor", "<origin xyz=\"0 0 -0.05\"/>") +
+            joint("fixed", "world", "table", "<origin xyz=\"0 0 0.7\"/>") +
+            floatingJoint("box", "<origin xyz=\"0 0 1\"/>", "table"));
+  const drb::SceneQueries low(drb::loadSceneFromUrdf(kTableScene, drb::SceneOptions()), drb::standardGravity());
+  const drb::SceneQueries high(drb::loadSceneFromUrdf(higher_table, drb::SceneOptions()), drb::standardGravity());
+  const std::vector<double> q{ 0.3, -0.2, 0.1, 0.4, 0.5, 1.6 }, qdot{ 1, 2, 3, 4, 5, 6 };
+  const std::vector<std::string> frames{ "table", "box" };
+  auto ask = [&](const drb::SceneQueries& queries, bool bias) {
+    drb::FrameJacobianAnswer answer;
+    queries.frameJacobians(queries.initialState(), "box", frames, q, qdot, 2, bias, answer);
+    return answer;
+  };
+  auto askOnFreshThread = [&](const drb::SceneQueries& queries, bool bias) {
+    drb::FrameJacobianAnswer answer;
+    std::thread([&] { answer = ask(queries, bias); }).join();
+    return answer;
+  };
+  for (const auto& [queries, bias] : { std::make_pair(&low, true), std::make_pair(&high, true),
+                                       std::make_pair(&high, false), std::make_pair(&low, false),
+                                       std::make_pair(&low, true) })
+  {
+    const drb::FrameJacobianAnswer kept = ask(*queries, bias), fresh = askOnFreshThread(*queries, bias);
+    EXPECT_EQ(kept.poses, fresh.poses);
+    EXPECT_EQ(kept.jacobians, fresh.jacobians);
+    EXPECT_EQ(kept.acceleration_bias, fresh.acceleration_bias);
+    EXPECT_EQ(kept.poses[2], queries == &low ? 0.5 : 0.7);  // the table's height in this scene
   }
 }
 }  // namespace

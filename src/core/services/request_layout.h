@@ -52,25 +52,25 @@ inline const RequestLayout& requestLayout(const SceneQueries& queries, const std
   return layout;
 }
 
-/// The K of a dynamics request: from q (K D values; empty = 1), with each
-/// other array of q's length (K D) or empty, every value finite.
-inline std::size_t dynamicsConfigurations(const detail::RequestLayout& layout, std::size_t bodies,
+/// The K of a dynamics request on `bodies` bodies of D coordinates in all: from q (K D values;
+/// empty = 1), with each other array of q's length (K D) or empty, every value finite.
+inline std::size_t dynamicsConfigurations(std::size_t D, std::size_t bodies,
                                    DoubleView q,
                                    std::initializer_list<std::pair<const char*, const DoubleView*>> others)
 {
-  if (!q.empty() && (bodies == 0 || q.size() % layout.D != 0))
+  if (!q.empty() && (bodies == 0 || q.size() % D != 0))
     detail::reject(detail::sizeMismatch("q",
-                        "a multiple of " + std::to_string(layout.D) + " values (the sum of the " +
+                        "a multiple of " + std::to_string(D) + " values (the sum of the " +
                             std::to_string(bodies) + " bodies' dofs), or empty for the current state",
                         q.size()));
-  const std::size_t configurations = q.empty() ? 1 : q.size() / layout.D;
+  const std::size_t configurations = q.empty() ? 1 : q.size() / D;
   requireFinite(q.data(), q.size(), "q");
   for (const auto& [field, values] : others)
   {
-    if (!values->empty() && values->size() != configurations * layout.D)
+    if (!values->empty() && values->size() != configurations * D)
       detail::reject(detail::sizeMismatch(field,
-                          std::to_string(configurations * layout.D) + " values (q's " + std::to_string(configurations) +
-                              " configuration(s) x " + std::to_string(layout.D) + "), or empty for zeros",
+                          std::to_string(configurations * D) + " values (q's " + std::to_string(configurations) +
+                              " configuration(s) x " + std::to_string(D) + "), or empty for zeros",
                           values->size()));
     requireFinite(values->data(), values->size(), field);
   }
@@ -95,7 +95,7 @@ inline BatchedBodies batchedBodies(const SceneQueries& queries, const std::vecto
   thread_local std::vector<std::size_t> indices;
   queries.bodyIndices(names, "bodies", indices);
   const RequestLayout& layout = requestLayout(queries, indices);
-  return { indices, layout, dynamicsConfigurations(layout, indices.size(), q, others) };
+  return { indices, layout, dynamicsConfigurations(layout.D, indices.size(), q, others) };
 }
 
 /// Refuses an answer of more doubles than the budget of get_mass_matrix

@@ -90,38 +90,51 @@ void frameSlots(const Scene& scene, std::size_t body_index, const std::vector<st
   }
 }
 
-/// This thread's reused buffers for frameJacobians: the listed frames' slots, and the segments
-/// whose placement they need. The needed segments are marked again only when the scene, the body,
-/// the frames' links or the acceleration bias (which needs every segment) change.
+/// This thread's resolution of its last frameJacobians request: the body, the listed frames'
+/// slots and the segments whose placement they need. A request that names the same body and
+/// frames on the same scene reuses it (no name lookups); the needed segments are marked again
+/// only when the frames or the acceleration bias (which needs every segment) change.
 class FrameScratch
 {
 public:
+  std::size_t body_index = 0;
   std::vector<FrameSlot> slots;
-  std::vector<std::size_t> indices;
 
-  const std::vector<char>& needed(std::uint64_t scene_id, std::size_t body_index, const BodyModel& body,
-                                  bool every_segment)
+  /// Unless this thread's previous request on scene `scene_id` named the same body and frames:
+  /// body_index = resolve(slots), which fills the slots (and refuses unknown names).
+  template <typename Resolve>
+  void lookUp(std::uint64_t scene_id, const std::string& body_name, const std::vector<std::string>& frames,
+              const Resolve& resolve)
   {
-    links_.clear();
-    for (const FrameSlot& slot : slots)
-      if (!slot.fixed)
-        links_.push_back(slot.index);
-    if (scene_id == scene_id_ && body_index == body_index_ && every_segment == every_segment_ && links_ == marked_)
+    if (scene_id == scene_id_ && body_name == body_name_ && frames == frames_)
+      return;
+    scene_id_ = 0;  // nothing is resolved until resolve() returns
+    marked_ = false;
+    body_index = resolve(slots);
+    body_name_ = body_name;
+    frames_ = frames;
+    scene_id_ = scene_id;
+  }
+
+  const std::vector<char>& needed(const BodyModel& body, bool every_segment)
+  {
+    if (marked_ && every_segment == every_segment_)
       return needed_;
     needed_.assign(body.segments.size(), every_segment ? 1 : 0);
-    for (std::size_t link : links_)
-      markSupport(body, link, needed_);
-    scene_id_ = scene_id, body_index_ = body_index, every_segment_ = every_segment;
-    marked_ = links_;
+    for (const FrameSlot& slot : slots)
+      if (!slot.fixed)
+        markSupport(body, slot.index, needed_);
+    every_segment_ = every_segment;
+    marked_ = true;
     return needed_;
   }
 
 private:
-  std::vector<std::size_t> links_, marked_;
+  std::uint64_t scene_id_ = 0;  // SceneQueries ids start at 1
+  std::string body_name_;
+  std::vector<std::string> frames_;
   std::vector<char> needed_;
-  std::uint64_t scene_id_ = 0;
-  std::size_t body_index_ = 0;
-  bool every_segment_ = false;
+  bool marked_ = false, every_segment_ = false;
 };
 
 FrameReference frameReference(std::uint32_t reference)
@@ -153,16 +166,18 @@ void SceneQueries::frameJacobians(const SceneState& current, const std::string& 
                                   DoubleView qdot, std::uint32_t reference, bool acceleration_bias,
                                   FrameJacobianAnswer& answer) const
 {
-  const std::size_t index = bodyIndex(body_name, "body");
-  const BodyModel& body = scene_.bodies[index];
   thread_local FrameScratch scratch;
+  scratch.lookUp(id_, body_name, frames, [&](std::vector<FrameSlot>& slots) {
+    const std::size_t found = bodyIndex(body_name, "body");
+    frameSlots(scene_, found, frames, link_index_, slots);
+    return found;
+  });
+  const std::size_t index = scratch.body_index;
+  const BodyModel& body = scene_.bodies[index];
   const std::vector<FrameSlot>& slots = scratch.slots;
-  frameSlots(scene_, index, frames, link_index_, scratch.slots);
   const FrameReference ref = frameReference(reference);
-  scratch.indices.assign(1, index);
-  const detail::RequestLayout& layout = detail::requestLayout(*this, scratch.indices);
-  const std::size_t K = dynamicsConfigurations(layout, 1, q, { { "qdot", &qdot } });
   const std::size_t d = body.coordinates, F = slots.size();
+  const std::size_t K = dynamicsConfigurations(d, 1, q, { { "qdot", &qdot } });
   checkDynamicsBudget(K, F * (12 + 6 * d + (acceleration_bias ? 6 : 0)) + 1, true);
   answer.frames.resize(F);
   for (std::size_t f = 0; f < F; ++f)
@@ -176,7 +191,7 @@ void SceneQueries::frameJacobians(const SceneState& current, const std::string& 
   answer.cos_theta.resize(K);
   BodyWorkspace<double>& ws = workspace(index);
   // Without the bias, only the listed frames' paths to the root are placed.
-  const std::vector<char>& needed = scratch.needed(id_, index, body, acceleration_bias);
+  const std::vector<char>& needed = scratch.needed(body, acceleration_bias);
   for (std::size_t k = 0; k < K; ++k)
   {
     const double* x = q.empty() ? current[index].data() : q.data() + k * d;

@@ -41,14 +41,20 @@ bool allFinite(const double* values, std::size_t count)
 {
   std::size_t i = 0;
 #ifdef __SSE2__
-  __m128d unordered = _mm_setzero_pd();
-  for (; i + 2 <= count; i += 2)
-  {
-    const __m128d x = _mm_loadu_pd(values + i);
+  const auto nonFinite = [values](std::size_t at) {
+    const __m128d x = _mm_loadu_pd(values + at);
     const __m128d zero_or_nan = _mm_sub_pd(x, x);
-    unordered = _mm_or_pd(unordered, _mm_cmpunord_pd(zero_or_nan, zero_or_nan));
+    return _mm_cmpunord_pd(zero_or_nan, zero_or_nan);
+  };
+  __m128d unordered_a = _mm_setzero_pd(), unordered_b = _mm_setzero_pd();  // two chains: 4 values a step
+  for (; i + 4 <= count; i += 4)
+  {
+    unordered_a = _mm_or_pd(unordered_a, nonFinite(i));
+    unordered_b = _mm_or_pd(unordered_b, nonFinite(i + 2));
   }
-  if (_mm_movemask_pd(unordered) != 0)
+  if (i + 2 <= count)
+    unordered_a = _mm_or_pd(unordered_a, nonFinite(i)), i += 2;
+  if (_mm_movemask_pd(_mm_or_pd(unordered_a, unordered_b)) != 0)
     return false;
 #endif
   for (; i < count; ++i)
