@@ -14,22 +14,10 @@
 //
 // The list is written at configure time (cmake/service_tables.py) from the
 // first line of each .srv of DRB_SERVICE_FILES (CMakeLists.txt), e.g.
-//   # [service] ~get_mass_matrix; Python: mass_matrix; C++: massMatrices
+//   # [service] ~get_mass_matrix; Python: mass_matrix; C++: massMatrices; core: massMatrices -> MassMatrixAnswer
+// (DRB_CORE_SERVICES in service_tables.h: the services a core member answers).
 // Adding a service: see docs/architecture.md ("Adding a service").
 #pragma once
 
-#include <diff_rigid_body/Backprop.h>
-#include <diff_rigid_body/Echo.h>
-#include <diff_rigid_body/ForwardDynamics.h>
-#include <diff_rigid_body/GetBodies.h>
-#include <diff_rigid_body/GetCenterOfMass.h>
-#include <diff_rigid_body/GetFrameJacobians.h>
-#include <diff_rigid_body/GetMassMatrix.h>
-#include <diff_rigid_body/GetState.h>
-#include <diff_rigid_body/GetVertexJacobians.h>
-#include <diff_rigid_body/GetVertexJacobiansCompact.h>
-#include <diff_rigid_body/InverseDynamics.h>
-#include <diff_rigid_body/Ping.h>
-#include <diff_rigid_body/SetState.h>
-
-#include "diff_rigid_body/services/service_tables.h"  // DIFF_RIGID_BODY_SERVICES, generated from srv/*.srv
+// Every srv type's header and DIFF_RIGID_BODY_SERVICES, generated from srv/*.srv.
+#include "diff_rigid_body/services/service_messages.h"

@@ -22,9 +22,12 @@ from diff_rigid_body.client_queries import SceneQueries
 
 __all__ = ['LocalScene']
 
-#: The services a local scene answers: the node's state-free ones.
-LOCAL_SERVICES = ('get_bodies', 'get_mass_matrix', 'get_vertex_jacobians', 'get_vertex_jacobians_compact',
-                  'backprop', 'inverse_dynamics', 'forward_dynamics', 'get_frame_jacobians', 'get_center_of_mass')
+
+def local_services():
+    """The services a local scene answers: the node's state-free ones (``_local.SERVICES``, bound
+    from the services' declarations)."""
+    from diff_rigid_body import _local
+    return _local.SERVICES
 
 
 def package_folder(package):
@@ -61,7 +64,7 @@ class LocalScene(SceneQueries):
     def call(self, name, **request):
         """Answers service ``name`` in process: the response's fields as attributes (numpy arrays,
         lists of names), or DiffRigidBodyError with the node's message."""
-        if name not in LOCAL_SERVICES:
+        if name not in local_services():
             raise ValueError('LocalScene answers the state-free services %s, not %r (a local scene has no state)'
-                             % (', '.join(LOCAL_SERVICES), name))
+                             % (', '.join(local_services()), name))
         return types.SimpleNamespace(**getattr(self._scene, name)(**request))

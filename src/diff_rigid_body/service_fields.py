@@ -2,10 +2,16 @@
 request and its answer hold, and which of their arrays run over the K configurations of a batched
 call.
 
-The first line names the service and the methods that wrap it:
+The first line names the service and the methods that wrap it, and, for a state-free query,
+the SceneQueries member that answers it and that member's answer struct:
 
-    # [service] ~get_mass_matrix; Python: mass_matrix; C++: massMatrices
+    # [service] ~get_mass_matrix; Python: mass_matrix; C++: massMatrices; core: massMatrices -> MassMatrixAnswer
     # [service] ~ping; benchmark only (advertised with ~benchmark_services:=true)
+
+A core member takes (the current state, the request fields in the .srv's order, the answer), and
+the answer struct holds the response fields but success and message. From that the node's
+handler, the in-process module's method (``diff_rigid_body._local``) and the fuzz target's call
+follow (``DRB_CORE_SERVICES`` in ``service_tables.h``).
 
 The node advertises every declared service (``DIFF_RIGID_BODY_SERVICES`` in ``services.h``, from
 ``service_tables.h``), the Python client holds those with a Python method in its ``SERVICES``, and
@@ -33,10 +39,12 @@ PER_CONFIGURATION = '[per configuration]'
 #: One field: its ROS type (``float64[]``), name and whether it runs over the configurations.
 Field = collections.namedtuple('Field', 'type name per_configuration')
 
-#: A service's name (without ~), its Python and C++ client methods (None: benchmark only).
-Declaration = collections.namedtuple('Declaration', 'name python cpp benchmark_only')
+#: A service's name (without ~), its Python and C++ client methods (None: benchmark only), and
+#: the SceneQueries member that answers it with its answer struct (None: answered by the node).
+Declaration = collections.namedtuple('Declaration', 'name python cpp benchmark_only core answer')
 
-_DECLARATION = re.compile(r'^#\s*\[service\]\s*~(\w+)\s*;\s*(?:Python:\s*(\w+)\s*;\s*C\+\+:\s*(\w+)|(benchmark only))')
+_DECLARATION = re.compile(r'^#\s*\[service\]\s*~(\w+)\s*;\s*(?:Python:\s*(\w+)\s*;\s*C\+\+:\s*(\w+)'
+                          r'(?:\s*;\s*core:\s*(\w+)\s*->\s*(\w+))?|(benchmark only))')
 _FIELD = re.compile(r'^\s*([A-Za-z_][\w/]*(?:\[\d*\])?)\s+([A-Za-z_]\w*)\s*(?:#\s*(.*))?$')
 
 
@@ -46,8 +54,8 @@ def parse_declaration(text):
     match = _DECLARATION.match(text.lstrip())
     if match is None:
         return None
-    name, python, cpp, benchmark_only = match.groups()
-    return Declaration(name, python, cpp, benchmark_only is not None)
+    name, python, cpp, core, answer, benchmark_only = match.groups()
+    return Declaration(name, python, cpp, benchmark_only is not None, core, answer)
 
 
 def declared_services(srv_module):

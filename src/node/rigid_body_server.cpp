@@ -223,30 +223,6 @@ bool RigidBodyServer::getState(GetState::Request& request, GetState::Response& r
   });
 }
 
-bool RigidBodyServer::getMassMatrix(GetMassMatrix::Request& request, GetMassMatrix::Response& response)
-{
-  return serveAnswer<MassMatrixAnswer>(response, "get_mass_matrix", [&](MassMatrixAnswer& answer) {
-    queries_.massMatrices(*snapshot(), request.bodies, request.q, request.derivatives, answer);
-  });
-}
-
-bool RigidBodyServer::getVertexJacobians(GetVertexJacobians::Request& request,
-                                         GetVertexJacobians::Response& response)
-{
-  return serve(response, "get_vertex_jacobians", [&] {
-    queries_.vertexJacobians(*snapshot(), request.body, request.vertices, request.q, response.positions,
-                             response.jacobians);
-  });
-}
-
-bool RigidBodyServer::backprop(Backprop::Request& request, Backprop::Response& response)
-{
-  return serve(response, "backprop", [&] {
-    response.gradient =
-        queries_.backpropConfigurations(*snapshot(), request.body, request.vertices, request.gradients, request.q);
-  });
-}
-
 void RigidBodyServer::onSetStates(const BodyStateArray::ConstPtr& message)
 {
   const std::string failure = node::guardCallback("set_states", [&] { applyStates(message->states); });
@@ -296,37 +272,26 @@ bool RigidBodyServer::getVertexJacobiansCompact(GetVertexJacobiansCompact::Reque
   });
 }
 
-bool RigidBodyServer::inverseDynamics(InverseDynamics::Request& request, InverseDynamics::Response& response)
+void RigidBodyServer::prepare(GetFrameJacobians::Request& request) const
 {
-  return serveAnswer<InverseDynamicsAnswer>(response, "inverse_dynamics", [&](InverseDynamicsAnswer& answer) {
-    queries_.inverseDynamics(*snapshot(), request.bodies, request.q, request.qdot, request.qddot,
-                             request.coriolis_matrices, request.derivatives, answer);
-  });
+  node::removeFramePrefix(frame_prefix_, request.frames);  // "a/link" as tf names it, or "link"
 }
 
-bool RigidBodyServer::forwardDynamics(ForwardDynamics::Request& request, ForwardDynamics::Response& response)
-{
-  return serveAnswer<ForwardDynamicsAnswer>(response, "forward_dynamics", [&](ForwardDynamicsAnswer& answer) {
-    queries_.forwardDynamics(*snapshot(), request.bodies, request.q, request.qdot, request.tau, request.derivatives,
-                             answer);
-  });
-}
-
-bool RigidBodyServer::getFrameJacobians(GetFrameJacobians::Request& request, GetFrameJacobians::Response& response)
-{
-  return serveAnswer<FrameJacobianAnswer>(response, "get_frame_jacobians", [&](FrameJacobianAnswer& answer) {
-    node::removeFramePrefix(frame_prefix_, request.frames);  // "a/link" as tf names it, or "link"
-    queries_.frameJacobians(*snapshot(), request.body, request.frames, request.q, request.qdot, request.reference,
-                            request.acceleration_bias, answer);
-  });
-}
-
-bool RigidBodyServer::getCenterOfMass(GetCenterOfMass::Request& request, GetCenterOfMass::Response& response)
-{
-  return serveAnswer<CenterOfMassAnswer>(response, "get_center_of_mass", [&](CenterOfMassAnswer& answer) {
-    queries_.centerOfMass(*snapshot(), request.bodies, request.q, request.qdot, request.jacobians, answer);
-  });
-}
+// The handlers of the services a core member answers (DRB_CORE_SERVICES, from each .srv's
+// declaration): the member gets a snapshot of the state and the request's fields in the .srv's
+// order, and fills the answer that serveAnswer moves into the response.
+#define DRB_REQUEST_ARGUMENT(type, name) , request.name
+#define DRB_SERVE_CORE(Type, name, handler, member, Answer)                                                            \
+  bool RigidBodyServer::handler(Type::Request& request, Type::Response& response)                                      \
+  {                                                                                                                    \
+    return serveAnswer<Answer>(response, #name, [&](Answer& answer) {                                                  \
+      prepare(request);                                                                                                \
+      queries_.member(*snapshot() DRB_##Type##_REQUEST_FIELDS(DRB_REQUEST_ARGUMENT), answer);                          \
+    });                                                                                                                \
+  }
+DRB_CORE_SERVICES(DRB_SERVE_CORE)
+#undef DRB_SERVE_CORE
+#undef DRB_REQUEST_ARGUMENT
 
 bool RigidBodyServer::ping(Ping::Request&, Ping::Response& response)
 {

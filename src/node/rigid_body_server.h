@@ -102,6 +102,13 @@ private:
   bool handler(srv_type::Request& request, srv_type::Response& response);
   DIFF_RIGID_BODY_SERVICES(DRB_DECLARE_HANDLER)
 #undef DRB_DECLARE_HANDLER
+  /// What the node does to a request before the core member of its service (DRB_CORE_SERVICES)
+  /// sees it: nothing, but for the frames of get_frame_jacobians, named as tf names them.
+  template <typename Request>
+  void prepare(Request&) const
+  {
+  }
+  void prepare(GetFrameJacobians::Request& request) const;
   void onSetStates(const BodyStateArray::ConstPtr& message);
   /// joint_states: named joints set, unknown names ignored (each logged
   /// once), a message with a non-finite position, a position count other

@@ -62,22 +62,19 @@ PYBIND11_MODULE(_local, m)
   m.def("buffer_address", [](const InputArray<double>& values) {
     return reinterpret_cast<std::uintptr_t>(diff_rigid_body::python::Values<double>(values).data);
   }, "values"_a);
-  py::class_<LocalScene>(m, "Scene")
+  py::class_<LocalScene> scene(m, "Scene");
+  scene
       .def(py::init(&load), "urdf"_a, "is_path"_a, "geometry"_a = "collision", "bodies"_a = std::vector<std::string>(),
            "density"_a = py::none(), "joints"_a = "model", "strict_inertia"_a = false, "floating_base"_a = false,
            "fixed_frame"_a = "", "gravity"_a = std::vector<double>{ 0.0, 0.0, -9.81 }, "find_package"_a = py::none())
       .def_property_readonly("warnings", &LocalScene::warnings)
       .def("get_bodies", &LocalScene::getBodies)
-      .def("get_mass_matrix", &LocalScene::getMassMatrix, "bodies"_a, "q"_a, "derivatives"_a = false)
-      .def("get_vertex_jacobians", &LocalScene::getVertexJacobians, "body"_a, "vertices"_a, "q"_a)
       .def("get_vertex_jacobians_compact", &LocalScene::getVertexJacobiansCompact, "body"_a, "vertices"_a, "q"_a,
-           "positions_only"_a = false, "single_precision"_a = false)
-      .def("backprop", &LocalScene::backprop, "body"_a, "vertices"_a, "gradients"_a, "q"_a)
-      .def("inverse_dynamics", &LocalScene::inverseDynamics, "bodies"_a, "q"_a, "qdot"_a, "qddot"_a,
-           "coriolis_matrices"_a = false, "derivatives"_a = false)
-      .def("forward_dynamics", &LocalScene::forwardDynamics, "bodies"_a, "q"_a, "qdot"_a, "tau"_a,
-           "derivatives"_a = false)
-      .def("get_frame_jacobians", &LocalScene::getFrameJacobians, "body"_a, "frames"_a, "q"_a, "qdot"_a,
-           "reference"_a = 0, "acceleration_bias"_a = false)
-      .def("get_center_of_mass", &LocalScene::getCenterOfMass, "bodies"_a, "q"_a, "qdot"_a, "jacobians"_a = false);
+           "positions_only"_a = false, "single_precision"_a = false);
+  diff_rigid_body::python::bindCoreServices(scene);
+  // The services a Scene answers: the node's state-free ones.
+#define DRB_SERVICE_NAME(Type, name, handler, member, Answer) , #name
+  m.attr("SERVICES") =
+      py::make_tuple("get_bodies", "get_vertex_jacobians_compact" DRB_CORE_SERVICES(DRB_SERVICE_NAME));
+#undef DRB_SERVICE_NAME
 }

@@ -61,30 +61,24 @@ public:
   const std::vector<std::string>& warnings() const { return warnings_; }
 
   py::dict getBodies() const;
-  py::dict getMassMatrix(const std::vector<std::string>& bodies, const InputArray<double>& q, bool derivatives) const;
-  py::dict getVertexJacobians(const std::string& body, const InputArray<std::uint32_t>& vertices,
-                              const InputArray<double>& q) const;
   py::dict getVertexJacobiansCompact(const std::string& body, const InputArray<std::uint32_t>& vertices,
                                      const InputArray<double>& q, bool positions_only, bool single_precision) const;
-  py::dict backprop(const std::string& body, const InputArray<std::uint32_t>& vertices,
-                    const InputArray<double>& gradients, const InputArray<double>& q) const;
-  py::dict inverseDynamics(const std::vector<std::string>& bodies, const InputArray<double>& q,
-                           const InputArray<double>& qdot, const InputArray<double>& qddot, bool coriolis_matrices,
-                           bool derivatives) const;
-  py::dict forwardDynamics(const std::vector<std::string>& bodies, const InputArray<double>& q,
-                           const InputArray<double>& qdot, const InputArray<double>& tau, bool derivatives) const;
-  py::dict getFrameJacobians(const std::string& body, const std::vector<std::string>& frames,
-                             const InputArray<double>& q, const InputArray<double>& qdot, std::uint32_t reference,
-                             bool acceleration_bias) const;
-  py::dict getCenterOfMass(const std::vector<std::string>& bodies, const InputArray<double>& q,
-                           const InputArray<double>& qdot, bool jacobians) const;
+
+  const SceneQueries& queries() const { return *queries_; }
+  /// The URDF state: never read for a request with q (kept so that no query can meet an empty state).
+  const SceneState& state() const { return state_; }
 
 private:
   std::unique_ptr<SceneQueries> queries_;
-  /// The URDF state: never read for a request with q (kept so that no query can meet an empty state).
   SceneState state_;
   std::vector<std::string> warnings_;
 };
+
+/// Binds, as methods of `scene` named after their services, the services a core member answers
+/// (DRB_CORE_SERVICES, from each .srv's declaration): the request fields in the .srv's order as
+/// arguments (float64[] and uint32[] as numpy arrays, bools and uint8 with the default 0), the
+/// response fields as the dict's entries.
+void bindCoreServices(py::class_<LocalScene>& scene);
 
 }  // namespace python
 }  // namespace diff_rigid_body

@@ -1,6 +1,8 @@
 // LocalScene's queries: each calls the SceneQueries member that the node's handler of the same
 // service calls (src/node/rigid_body_server.cpp), with the GIL released, and moves the answer's
-// arrays into numpy (adopt) under the response's field names (the answer's field list).
+// arrays into numpy (adopt) under the response's field names (the answer's field list). The
+// services a core member answers are bound from their declarations (DRB_CORE_SERVICES).
+#include <cstring>
 #include <optional>
 
 #include <pybind11/stl.h>
@@ -43,6 +45,52 @@ Values<double> requiredQ(const InputArray<double>& q, const char* service)
   return Values<double>(q);
 }
 
+/// A request field of C++ type T as the module takes it (Input), holds it while the core runs
+/// (hold, with the GIL) and hands it to the core member (pass): as pybind converts it, but for
+/// float64[] (read in place when C-contiguous; q is required) and uint32[] (numpy arrays).
+template <typename T>
+struct LocalField
+{
+  using Input = T;
+  static const T& hold(const T& value, const char*, const char*) { return value; }
+  static const T& pass(const T& value) { return value; }
+};
+template <>
+struct LocalField<std::vector<double>>
+{
+  using Input = InputArray<double>;
+  static Values<double> hold(const Input& values, const char* field, const char* service)
+  {
+    return std::strcmp(field, "q") == 0 ? requiredQ(values, service) : Values<double>(values);
+  }
+  static DoubleView pass(const Values<double>& values) { return values.view(); }
+};
+template <>
+struct LocalField<std::vector<std::uint32_t>>
+{
+  using Input = InputArray<std::uint32_t>;
+  static std::vector<std::uint32_t> hold(const Input& values, const char*, const char*)
+  {
+    return Values<std::uint32_t>(values).vector();
+  }
+  static const std::vector<std::uint32_t>& pass(const std::vector<std::uint32_t>& values) { return values; }
+};
+
+/// The keyword argument of a request field: required, but for flags and small enumerations (0).
+template <typename T>
+py::arg keyword(const char* name, const T*)
+{
+  return py::arg(name);
+}
+py::arg_v keyword(const char* name, const bool*)
+{
+  return py::arg_v(name, false);
+}
+py::arg_v keyword(const char* name, const std::uint8_t*)
+{
+  return py::arg_v(name, 0);
+}
+
 // A response field as Python: numeric vectors handed to numpy (adopt), names as a list, scalars.
 template <typename T>
 py::object toPython(std::vector<T>&& values)
@@ -76,31 +124,6 @@ py::dict LocalScene::getBodies() const
   return r;
 }
 
-py::dict LocalScene::getMassMatrix(const std::vector<std::string>& bodies, const InputArray<double>& q,
-                                   bool derivatives) const
-{
-  const Values<double> x = requiredQ(q, "get_mass_matrix");
-  MassMatrixAnswer answer;
-  serve("get_mass_matrix", [&] { queries_->massMatrices(state_, bodies, x.view(), derivatives, answer); });
-  py::dict r;
-  DRB_GetMassMatrix_RESPONSE_FIELDS(DRB_PYTHON_FIELD)
-  return r;
-}
-
-py::dict LocalScene::getVertexJacobians(const std::string& body, const InputArray<std::uint32_t>& vertices,
-                                        const InputArray<double>& q) const
-{
-  const Values<double> x = requiredQ(q, "get_vertex_jacobians");
-  const Values<std::uint32_t> selected(vertices);
-  std::vector<double> positions, jacobians;
-  serve("get_vertex_jacobians",
-        [&] { queries_->vertexJacobians(state_, body, selected.vector(), x.view(), positions, jacobians); });
-  py::dict r;
-  r["positions"] = adopt(std::move(positions));
-  r["jacobians"] = adopt(std::move(jacobians));
-  return r;
-}
-
 py::dict LocalScene::getVertexJacobiansCompact(const std::string& body, const InputArray<std::uint32_t>& vertices,
                                                const InputArray<double>& q, bool positions_only,
                                                bool single_precision) const
@@ -124,74 +147,30 @@ py::dict LocalScene::getVertexJacobiansCompact(const std::string& body, const In
   return r;
 }
 
-py::dict LocalScene::backprop(const std::string& body, const InputArray<std::uint32_t>& vertices,
-                              const InputArray<double>& gradients, const InputArray<double>& q) const
-{
-  const Values<double> x = requiredQ(q, "backprop");
-  const Values<std::uint32_t> selected(vertices);
-  const Values<double> dl_dp(gradients);
-  std::vector<double> gradient;
-  serve("backprop", [&] {
-    queries_->backpropConfigurations(state_, body, selected.vector(), dl_dp.view(), x.view(), gradient);
-  });
-  py::dict r;
-  r["gradient"] = adopt(std::move(gradient));
-  return r;
-}
+// One method per row of DRB_CORE_SERVICES: the request fields as arguments (LocalField), the core
+// member on this scene's URDF state, the answer's fields as the dict.
+#define DRB_LOCAL_INPUT(type, name) , const LocalField<type>::Input& name
+#define DRB_LOCAL_HOLD(type, name) const auto& name##_held = LocalField<type>::hold(name, #name, service);
+#define DRB_LOCAL_PASS(type, name) , LocalField<type>::pass(name##_held)
+#define DRB_LOCAL_KEYWORD(type, name) , keyword(#name, static_cast<const type*>(nullptr))
+#define DRB_BIND_CORE(Type, name, handler, member, Answer)                                                             \
+  scene.def(                                                                                                           \
+      #name,                                                                                                           \
+      [](const LocalScene& self DRB_##Type##_REQUEST_FIELDS(DRB_LOCAL_INPUT)) {                                        \
+        const char* service = #name;                                                                                   \
+        DRB_##Type##_REQUEST_FIELDS(DRB_LOCAL_HOLD)                                                                    \
+        Answer answer;                                                                                                 \
+        serve(service, [&] {                                                                                           \
+          self.queries().member(self.state() DRB_##Type##_REQUEST_FIELDS(DRB_LOCAL_PASS), answer);                     \
+        });                                                                                                            \
+        py::dict r;                                                                                                    \
+        DRB_##Type##_RESPONSE_FIELDS(DRB_PYTHON_FIELD)                                                                 \
+        return r;                                                                                                      \
+      } DRB_##Type##_REQUEST_FIELDS(DRB_LOCAL_KEYWORD));
 
-py::dict LocalScene::inverseDynamics(const std::vector<std::string>& bodies, const InputArray<double>& q,
-                                     const InputArray<double>& qdot, const InputArray<double>& qddot,
-                                     bool coriolis_matrices, bool derivatives) const
+void bindCoreServices(py::class_<LocalScene>& scene)
 {
-  const Values<double> x = requiredQ(q, "inverse_dynamics"), v(qdot), a(qddot);
-  InverseDynamicsAnswer answer;
-  serve("inverse_dynamics", [&] {
-    queries_->inverseDynamics(state_, bodies, x.view(), v.view(), a.view(), coriolis_matrices, derivatives,
-                              answer);
-  });
-  py::dict r;
-  DRB_InverseDynamics_RESPONSE_FIELDS(DRB_PYTHON_FIELD)
-  return r;
-}
-
-py::dict LocalScene::forwardDynamics(const std::vector<std::string>& bodies, const InputArray<double>& q,
-                                     const InputArray<double>& qdot, const InputArray<double>& tau,
-                                     bool derivatives) const
-{
-  const Values<double> x = requiredQ(q, "forward_dynamics"), v(qdot), t(tau);
-  ForwardDynamicsAnswer answer;
-  serve("forward_dynamics", [&] {
-    queries_->forwardDynamics(state_, bodies, x.view(), v.view(), t.view(), derivatives, answer);
-  });
-  py::dict r;
-  DRB_ForwardDynamics_RESPONSE_FIELDS(DRB_PYTHON_FIELD)
-  return r;
-}
-
-py::dict LocalScene::getFrameJacobians(const std::string& body, const std::vector<std::string>& frames,
-                                       const InputArray<double>& q, const InputArray<double>& qdot,
-                                       std::uint32_t reference, bool acceleration_bias) const
-{
-  const Values<double> x = requiredQ(q, "get_frame_jacobians"), v(qdot);
-  FrameJacobianAnswer answer;
-  serve("get_frame_jacobians", [&] {
-    queries_->frameJacobians(state_, body, frames, x.view(), v.view(), reference, acceleration_bias, answer);
-  });
-  py::dict r;
-  DRB_GetFrameJacobians_RESPONSE_FIELDS(DRB_PYTHON_FIELD)
-  return r;
-}
-
-py::dict LocalScene::getCenterOfMass(const std::vector<std::string>& bodies, const InputArray<double>& q,
-                                     const InputArray<double>& qdot, bool jacobians) const
-{
-  const Values<double> x = requiredQ(q, "get_center_of_mass"), v(qdot);
-  CenterOfMassAnswer answer;
-  serve("get_center_of_mass",
-        [&] { queries_->centerOfMass(state_, bodies, x.view(), v.view(), jacobians, answer); });
-  py::dict r;
-  DRB_GetCenterOfMass_RESPONSE_FIELDS(DRB_PYTHON_FIELD)
-  return r;
+  DRB_CORE_SERVICES(DRB_BIND_CORE)
 }
 
 }  // namespace python

@@ -6,6 +6,7 @@
 // one of set_state, get_state, get_mass_matrix, get_vertex_jacobians, its
 // compact variant (double and float32), backprop, inverse_dynamics and
 // forward_dynamics (fuzz_dynamics_requests.h) (K = 1 to 3 configurations),
+// or any service a core member answers (fuzz_declared_services.h),
 // with fuzzed body names (known, unknown, empty, repeated, random bytes), q,
 // rates, forces and gradients (any double: NaN, +-Inf, subnormals, +-0,
 // huge, +-pi/2, or plain values), vertex indices (in range or any uint32)
@@ -27,6 +28,7 @@
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include "diff_rigid_body/exceptions.h"
+#include "fuzz_declared_services.h"
 #include "fuzz_dynamics_requests.h"
 #include "fuzz_invariants.h"
 #include "fuzz_scene_inputs.h"
@@ -279,7 +281,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   drb::SceneState current = queries().initialState();
   for (int request = 0; request < 8 && in.remaining_bytes() > 0; ++request)
   {
-    switch (in.ConsumeIntegralInRange<int>(0, 8))
+    switch (in.ConsumeIntegralInRange<int>(0, 9))
     {
       case 0:
         setState(in, current);
@@ -305,8 +307,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       case 7:
         drb_fuzz::inverseDynamicsRequest(in, current);
         break;
-      default:
+      case 8:
         drb_fuzz::forwardDynamicsRequest(in, current);
+        break;
+      default:
+        drb_fuzz::declaredServiceRequest(in, current);
         break;
     }
   }

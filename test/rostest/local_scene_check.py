@@ -17,7 +17,7 @@ import rostest
 
 from diff_rigid_body import LocalScene, _local
 from diff_rigid_body.client import DiffRigidBodyError, RigidBodyClient
-from diff_rigid_body.local import LOCAL_SERVICES
+from diff_rigid_body.local import local_services
 
 WAIT = 60.0
 K = 5
@@ -74,7 +74,7 @@ class LocalSceneAgainstNode(unittest.TestCase):
 
     def test_a_every_state_free_service(self):
         """LocalScene answers every service of the client but the two about the node's state."""
-        self.assertEqual(set(LOCAL_SERVICES), set(RigidBodyClient.SERVICES) - {'get_state', 'set_state'})
+        self.assertEqual(set(local_services()), set(RigidBodyClient.SERVICES) - {'get_state', 'set_state'})
 
     def test_a_bodies(self):
         for name, (local, node, bodies) in self.pairs.items():

@@ -6,7 +6,8 @@ from the first line of each .srv into service_tables.h) against everything that 
 - the running node advertises exactly the registry's services: without
   ~benchmark_services the others, with it all of them;
 - every srv type is a file in srv/, listed in CMakeLists.txt's
-  DRB_SERVICE_FILES (add_service_files and service_tables.h) and included by services.h;
+  DRB_SERVICE_FILES (add_service_files and service_tables.h) and included by services.h (through
+  the generated service_messages.h);
 - the Python client (RigidBodyClient) has each service in SERVICES, with its
   srv type, and a method that calls it;
 - the C++ client header declares each C++ method, and calls the service with
@@ -20,6 +21,11 @@ sharding tables (pool_shards.py from the srv classes, service_tables.h generated
 sharding every float array of its request and every per-configuration float array of its answer:
 a .srv field without its "[per configuration]" marker would silently stop being split across
 instances.
+Every service a core member answers (DRB_CORE_SERVICES, `core:` in its declaration) declares its
+answer struct in scene_queries.h from its own response fields, so that the node and the in-process
+module move exactly the response's fields; the node answers the others itself, and the in-process
+module (_local.SERVICES) answers exactly the core services, get_bodies and
+get_vertex_jacobians_compact.
 GetBodies.srv and BodyState.msg comment every field in the user's terms, `rossrv show -r` prints the
 comments, and README.md names that command.
 """
@@ -45,6 +51,7 @@ ROSCPP_SERVICES = {'get_loggers', 'set_logger_level'}  # roscpp's own, on every 
 
 ENTRY = re.compile(r'^\s*X\(\s*(\w+)\s*,\s*(\w+)\s*,\s*(\w+)\s*,\s*(\w+)\s*,\s*(\w+)\s*,\s*(true|false)\s*\)', re.M)
 FIELDS = ('name', 'srv_type', 'handler', 'python_method', 'cpp_method', 'benchmark_only')
+CORE_ROW = re.compile(r'X\((\w+), (\w+), (\w+), (\w+), (\w+)\)')  # DRB_CORE_SERVICES' rows
 CPP_SHARDING = re.compile(r'X\((\w+), \(([^)]*)\), \(([^)]*)\)\)')  # DRB_SHARDED_SERVICES' rows
 PER_BODY_FIELDS = {'masses'}  # answer arrays of one value per body, the same in every shard
 
@@ -53,14 +60,15 @@ def package_file(*parts):
     return os.path.join(rospkg.RosPack().get_path(PKG), *parts)
 
 
-def generated_service_tables():
-    """The text of service_tables.h, generated from srv/*.srv into the devel (or install) space."""
+def generated_service_tables(name='service_tables.h'):
+    """The text of service_tables.h (or of service_messages.h), generated from srv/*.srv into the
+    devel (or install) space."""
     for prefix in os.environ.get('CMAKE_PREFIX_PATH', '').split(os.pathsep):
-        path = os.path.join(prefix, 'include', PKG, 'services', 'service_tables.h')
+        path = os.path.join(prefix, 'include', PKG, 'services', name)
         if prefix and os.path.isfile(path):
             with open(path) as f:
                 return f.read()
-    raise AssertionError('service_tables.h is in no include/%s/services of CMAKE_PREFIX_PATH' % PKG)
+    raise AssertionError('%s is in no include/%s/services of CMAKE_PREFIX_PATH' % (name, PKG))
 
 
 def read(*parts):
@@ -152,13 +160,15 @@ class ServiceRegistry(unittest.TestCase):
     def test_srv_files(self):
         cmake = read('CMakeLists.txt')
         listed = ' '.join(re.findall(r'set\(DRB_SERVICE_FILES([^)]*)\)', cmake)).split()
-        header = read('include', 'diff_rigid_body_ros', 'services.h')
+        self.assertIn('#include "diff_rigid_body/services/service_messages.h"',
+                      read('include', 'diff_rigid_body_ros', 'services.h'))
+        header = generated_service_tables('service_messages.h')
         for e in self.entries:
             srv = e['srv_type'] + '.srv'
             self.assertTrue(os.path.isfile(package_file('srv', srv)), '%s: srv/%s does not exist' % (e['name'], srv))
             self.assertIn(srv, listed, '%s: %s is not in DRB_SERVICE_FILES (CMakeLists.txt)' % (e['name'], srv))
             self.assertIn('#include <diff_rigid_body/%s.h>' % e['srv_type'], header,
-                          'services.h does not include the srv header of %s' % e['name'])
+                          'service_messages.h does not include the srv header of %s' % e['name'])
 
     def test_python_client_wraps_every_service(self):
         wrapped = {e['name'] for e in self.entries if e['python_method'] != 'none'}
@@ -212,6 +222,21 @@ class ServiceRegistry(unittest.TestCase):
                 self.assertEqual(entries[e['name']], wanted, '%s: the sharded fields of %s' % (table, e['name']))
         for table, entries in (('pool_shards.py SHARDED', python), ('service_tables.h', cpp)):
             self.assertEqual(set(entries) - batched, set(), '%s shards services without a q' % table)
+
+    def test_core_services_declare_their_answers_from_their_responses(self):
+        text = generated_service_tables()
+        table = text[text.index('#define DRB_CORE_SERVICES'):]
+        rows = CORE_ROW.findall(table[:table.index('\n\n')])
+        self.assertGreaterEqual(len(rows), 7, 'DRB_CORE_SERVICES: %s' % (rows,))
+        header = read('include', PKG, 'services', 'scene_queries.h')
+        for srv, name, _, member, answer in rows:
+            self.assertRegex(header, r'struct %s\s*\{\s*DRB_ANSWER\(DRB_%s_RESPONSE_FIELDS\)' % (answer, srv),
+                             '~%s: %s is not declared from %s.srv\'s response' % (name, answer, srv))
+            self.assertRegex(header, r'void %s\([^;]*%s& answer\) const' % (member, answer),
+                             '~%s: no SceneQueries::%s(..., %s& answer)' % (name, member, answer))
+        from diff_rigid_body import _local
+        self.assertEqual(set(_local.SERVICES),
+                         {name for _, name, _, _, _ in rows} | {'get_bodies', 'get_vertex_jacobians_compact'})
 
     def test_readme_services_table(self):
         rows = table_keys(markdown_section(read('README.md'), '### Services'), r'`~(\w+)`')

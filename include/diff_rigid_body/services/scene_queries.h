@@ -129,6 +129,18 @@ struct CenterOfMassAnswer
   DRB_ANSWER(DRB_GetCenterOfMass_RESPONSE_FIELDS)
 };
 
+/// ~get_vertex_jacobians: positions and jacobians as vertexJacobians writes them.
+struct VertexJacobiansAnswer
+{
+  DRB_ANSWER(DRB_GetVertexJacobians_RESPONSE_FIELDS)
+};
+
+/// ~backprop: gradient as backpropConfigurations writes it.
+struct BackpropAnswer
+{
+  DRB_ANSWER(DRB_Backprop_RESPONSE_FIELDS)
+};
+
 /// Standard gravity in the fixed frame, -9.81 m/s^2 along z (~gravity's default).
 inline Eigen::Vector3d standardGravity()
 {
@@ -208,6 +220,11 @@ public:
   void vertexJacobians(const SceneState& current, const std::string& body, const std::vector<std::uint32_t>& vertices,
                        DoubleView q, std::vector<double>& positions,
                        std::vector<double>& jacobians) const;
+  void vertexJacobians(const SceneState& current, const std::string& body, const std::vector<std::uint32_t>& vertices,
+                       DoubleView q, VertexJacobiansAnswer& answer) const
+  {
+    vertexJacobians(current, body, vertices, q, answer.positions, answer.jacobians);
+  }
 
   /// The reduced transport of vertexJacobians (~get_vertex_jacobians_compact):
   /// positions (3 per vertex) and, unless `positions_only`, J without the
@@ -232,6 +249,12 @@ public:
   void backpropConfigurations(const SceneState& current, const std::string& body,
                               const std::vector<std::uint32_t>& vertices, DoubleView gradients,
                               DoubleView q, std::vector<double>& gradient) const;
+  void backpropConfigurations(const SceneState& current, const std::string& body,
+                              const std::vector<std::uint32_t>& vertices, DoubleView gradients, DoubleView q,
+                              BackpropAnswer& answer) const
+  {
+    backpropConfigurations(current, body, vertices, gradients, q, answer.gradient);
+  }
   std::vector<double> backpropConfigurations(const SceneState& current, const std::string& body,
                                              const std::vector<std::uint32_t>& vertices,
                                              DoubleView gradients,
