@@ -122,6 +122,16 @@ TEST_F(Allocations, InverseAndForwardDynamicsWithDerivatives)
   EXPECT_EQ(allocationsOf([&] { queries_.forwardDynamics(current_, names_, q_, qdot_, qdot_, true, forward); }), 0);
 }
 
+TEST_F(Allocations, FrameJacobiansAndCenterOfMass)
+{
+  drb::FrameJacobianAnswer frames;
+  drb::CenterOfMassAnswer com;
+  const std::vector<std::string> tip{ queries_.body(0).links.back().name };
+  EXPECT_EQ(allocationsOf([&] { queries_.frameJacobians(current_, body_, tip, q_, {}, 2, false, frames); }), 0);
+  EXPECT_EQ(allocationsOf([&] { queries_.frameJacobians(current_, body_, {}, q_, qdot_, 0, true, frames); }), 0);
+  EXPECT_EQ(allocationsOf([&] { queries_.centerOfMass(current_, names_, q_, qdot_, true, com); }), 0);
+}
+
 TEST_F(Allocations, LinkPosesForTf)
 {
   std::vector<Eigen::Isometry3d> poses;
