@@ -63,29 +63,6 @@ struct CenterOfMassResult
   std::size_t index(std::size_t k, std::size_t i) const { return k * bodies.size() + i; }
 };
 
-namespace detail
-{
-inline diff_rigid_body::GetFrameJacobians frameJacobiansRequest(const std::string& body,
-                                                                const std::vector<std::string>& frames,
-                                                                std::vector<double> q, std::vector<double> qdot,
-                                                                FrameReference reference, bool acceleration_bias)
-{
-  using R = diff_rigid_body::GetFrameJacobians::Request;
-  return requestOf<diff_rigid_body::GetFrameJacobians>(&R::body, body, &R::frames, frames, &R::q, std::move(q),
-                                                       &R::qdot, std::move(qdot), &R::reference, reference,
-                                                       &R::acceleration_bias, acceleration_bias);
-}
-
-inline diff_rigid_body::GetCenterOfMass centerOfMassRequest(const std::vector<std::string>& bodies,
-                                                            std::vector<double> q, std::vector<double> qdot,
-                                                            bool jacobians)
-{
-  using R = diff_rigid_body::GetCenterOfMass::Request;
-  return requestOf<diff_rigid_body::GetCenterOfMass>(&R::bodies, bodies, &R::q, std::move(q), &R::qdot,
-                                                     std::move(qdot), &R::jacobians, jacobians);
-}
-}  // namespace detail
-
 inline FrameJacobians toFrameJacobians(const diff_rigid_body::GetFrameJacobians::Response& r)
 {
   using RowMajor = Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor>;

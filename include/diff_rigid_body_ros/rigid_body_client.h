@@ -100,7 +100,7 @@ public:
   MassMatrices massMatrices(const std::vector<std::string>& bodies = {}, const std::vector<double>& q = {},
                             bool derivatives = false)
   {
-    auto srv = detail::massMatrixRequest(bodies, q, derivatives);
+    auto srv = detail::requestOf<diff_rigid_body::GetMassMatrix>(bodies, q, derivatives);
     call("get_mass_matrix", srv);
     return toMassMatrices(srv.response, derivatives);
   }
@@ -122,7 +122,8 @@ public:
                                         const std::vector<double>& qddot = {}, bool coriolis_matrices = false,
                                         bool derivatives = false)
   {
-    auto srv = detail::inverseDynamicsRequest(bodies, q, qdot, qddot, coriolis_matrices, derivatives);
+    auto srv = detail::requestOf<diff_rigid_body::InverseDynamics>(bodies, q, qdot, qddot, coriolis_matrices,
+                                                                   derivatives);
     call("inverse_dynamics", srv);
     return toInverseDynamics(srv.response);
   }
@@ -136,7 +137,7 @@ public:
                                         const std::vector<double>& q = {}, const std::vector<double>& qdot = {},
                                         const std::vector<double>& tau = {}, bool derivatives = false)
   {
-    auto srv = detail::forwardDynamicsRequest(bodies, q, qdot, tau, derivatives);
+    auto srv = detail::requestOf<diff_rigid_body::ForwardDynamics>(bodies, q, qdot, tau, derivatives);
     call("forward_dynamics", srv);
     return toForwardDynamics(srv.response);
   }
@@ -150,7 +151,8 @@ public:
                                 FrameReference reference = FrameReference::LocalWorldAligned,
                                 bool acceleration_bias = false)
   {
-    auto srv = detail::frameJacobiansRequest(body, frames, q, qdot, reference, acceleration_bias);
+    auto srv = detail::requestOf<diff_rigid_body::GetFrameJacobians>(
+        body, frames, q, qdot, static_cast<std::uint8_t>(reference), acceleration_bias);
     call("get_frame_jacobians", srv);
     return toFrameJacobians(srv.response);
   }
@@ -161,7 +163,7 @@ public:
   CenterOfMassResult centerOfMass(const std::vector<std::string>& bodies = {}, const std::vector<double>& q = {},
                                   const std::vector<double>& qdot = {}, bool jacobians = false)
   {
-    auto srv = detail::centerOfMassRequest(bodies, q, qdot, jacobians);
+    auto srv = detail::requestOf<diff_rigid_body::GetCenterOfMass>(bodies, q, qdot, jacobians);
     call("get_center_of_mass", srv);
     return toCenterOfMass(srv.response);
   }
@@ -306,7 +308,7 @@ private:
                                                       const std::vector<std::uint32_t>& vertices,
                                                       std::vector<double> q, std::size_t K)
   {
-    auto srv = detail::vertexJacobiansRequest(body, vertices, std::move(q));
+    auto srv = detail::requestOf<diff_rigid_body::GetVertexJacobians>(body, vertices, std::move(q));
     call("get_vertex_jacobians", srv);
     return toVertexJacobians(srv.response, K);
   }
@@ -329,7 +331,8 @@ private:
                                                const std::vector<const Eigen::Matrix3Xd*>& dL_dp,
                                                std::vector<double> q, std::size_t K)
   {
-    auto srv = detail::backpropRequest(body, vertices, detail::flattenGradients(dL_dp), std::move(q));
+    auto srv = detail::requestOf<diff_rigid_body::Backprop>(body, vertices, detail::flattenGradients(dL_dp),
+                                                            std::move(q));
     call("backprop", srv);
     return toGradients(srv.response, K);
   }

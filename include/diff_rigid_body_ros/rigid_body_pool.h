@@ -71,7 +71,7 @@ public:
   MassMatrices massMatrices(const std::vector<std::string>& bodies, const std::vector<double>& q,
                             bool derivatives = false)
   {
-    auto srv = detail::massMatrixRequest(bodies, q, derivatives);
+    auto srv = detail::requestOf<diff_rigid_body::GetMassMatrix>(bodies, q, derivatives);
     call(srv);
     return toMassMatrices(srv.response, derivatives);
   }
@@ -81,7 +81,8 @@ public:
                                         const std::vector<double>& qdot = {}, const std::vector<double>& qddot = {},
                                         bool coriolis_matrices = false, bool derivatives = false)
   {
-    auto srv = detail::inverseDynamicsRequest(bodies, q, qdot, qddot, coriolis_matrices, derivatives);
+    auto srv = detail::requestOf<diff_rigid_body::InverseDynamics>(bodies, q, qdot, qddot, coriolis_matrices,
+                                                                   derivatives);
     call(srv);
     return toInverseDynamics(srv.response);
   }
@@ -91,7 +92,7 @@ public:
                                         const std::vector<double>& qdot = {}, const std::vector<double>& tau = {},
                                         bool derivatives = false)
   {
-    auto srv = detail::forwardDynamicsRequest(bodies, q, qdot, tau, derivatives);
+    auto srv = detail::requestOf<diff_rigid_body::ForwardDynamics>(bodies, q, qdot, tau, derivatives);
     call(srv);
     return toForwardDynamics(srv.response);
   }
@@ -102,7 +103,8 @@ public:
                                 FrameReference reference = FrameReference::LocalWorldAligned,
                                 bool acceleration_bias = false)
   {
-    auto srv = detail::frameJacobiansRequest(body, frames, q, qdot, reference, acceleration_bias);
+    auto srv = detail::requestOf<diff_rigid_body::GetFrameJacobians>(
+        body, frames, q, qdot, static_cast<std::uint8_t>(reference), acceleration_bias);
     call(srv);
     return toFrameJacobians(srv.response);
   }
@@ -110,7 +112,7 @@ public:
   CenterOfMassResult centerOfMass(const std::vector<std::string>& bodies, const std::vector<double>& q,
                                   const std::vector<double>& qdot = {}, bool jacobians = false)
   {
-    auto srv = detail::centerOfMassRequest(bodies, q, qdot, jacobians);
+    auto srv = detail::requestOf<diff_rigid_body::GetCenterOfMass>(bodies, q, qdot, jacobians);
     call(srv);
     return toCenterOfMass(srv.response);
   }
@@ -125,7 +127,7 @@ public:
   std::vector<VertexJacobians> vertexJacobians(const std::string& body, const std::vector<Vector>& qs,
                                                const std::vector<std::uint32_t>& vertices = {})
   {
-    auto srv = detail::vertexJacobiansRequest(body, vertices, detail::flatten(qs));
+    auto srv = detail::requestOf<diff_rigid_body::GetVertexJacobians>(body, vertices, detail::flatten(qs));
     call(srv);
     return toVertexJacobians(srv.response, qs.size());
   }
@@ -143,7 +145,8 @@ public:
     if (dL_dp.size() != qs.size())
       throw std::invalid_argument("backprop: " + std::to_string(dL_dp.size()) + " gradient blocks for " +
                                   std::to_string(qs.size()) + " configurations");
-    auto srv = detail::backpropRequest(body, vertices, detail::flattenGradients(dL_dp), detail::flatten(qs));
+    auto srv = detail::requestOf<diff_rigid_body::Backprop>(body, vertices, detail::flattenGradients(dL_dp),
+                                                            detail::flatten(qs));
     call(srv);
     const std::vector<Eigen::VectorXd> out = toGradients(srv.response, qs.size());
     return std::vector<Vector>(out.begin(), out.end());
