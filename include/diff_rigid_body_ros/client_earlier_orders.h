@@ -11,9 +11,12 @@
 //
 // The earlier overloads deduce the type of their first moved argument, so that a braced list
 // there ({} for all bodies) never selects them: `inverseDynamics({}, q)` is the current order.
+// Braced frame names in the earlier place, `frameJacobians(body, q, {"link"})`, select the
+// earlier order (an array of at least one name); `{}` and braced numbers there are qdot.
 // A CRTP base of EigenBatches (client_batches.h).
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -80,6 +83,15 @@ public:
                  bool acceleration_bias = false)
   {
     return derived().frameJacobians(body, q, qdot, frames, reference, acceleration_bias);
+  }
+  template <std::size_t N>
+  [[deprecated("frameJacobians(body, q, qdot, frames, reference, ...): qdot comes before frames now")]] FrameJacobians
+  frameJacobians(const std::string& body, const std::vector<double>& q, const std::string (&frames)[N],
+                 FrameReference reference = FrameReference::LocalWorldAligned, const std::vector<double>& qdot = {},
+                 bool acceleration_bias = false)
+  {
+    return derived().frameJacobians(body, q, qdot, std::vector<std::string>(frames, frames + N), reference,
+                                    acceleration_bias);
   }
 
 private:

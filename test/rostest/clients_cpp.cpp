@@ -174,8 +174,13 @@ TEST(CppClient, BatchedCallsTakeOneEigenVectorPerConfiguration)
   const auto earlier_qddot6 = client.forwardDynamics(qs, qdots, {}, { "knot" });
   const std::vector<std::string> frames = client.frameJacobians("knot", flat).frames;
   const auto earlier_frames = client.frameJacobians("knot", flat, frames, World, flat_qdot, true);
+  const auto earlier_braced = client.frameJacobians("knot", flat, { "knot" }, World, flat_qdot, true);
 #pragma GCC diagnostic pop
   const auto frames_now = client.frameJacobians("knot", flat, flat_qdot, frames, World, true);
+  const auto braced_now = client.frameJacobians("knot", flat, flat_qdot, { "knot" }, World, true);
+  const auto empty_qdot = client.frameJacobians("knot", flat, {}, { "knot" }, World);  // {} is qdot: the current order
+  ASSERT_EQ(earlier_braced.frames, std::vector<std::string>{ "knot" });
+  ASSERT_EQ(empty_qdot.frames, std::vector<std::string>{ "knot" });
   for (std::size_t k = 0; k < 3; ++k)
   {
     EXPECT_EQ(earlier_tau.tau[k], tau.tau[k]);
@@ -184,6 +189,9 @@ TEST(CppClient, BatchedCallsTakeOneEigenVectorPerConfiguration)
     EXPECT_EQ(earlier_qddot6.qddot[k], qddot.qddot[k]);
     EXPECT_EQ(earlier_frames.J[k], frames_now.J[k]);
     EXPECT_EQ(earlier_frames.bias[k], frames_now.bias[k]);
+    EXPECT_EQ(earlier_braced.J[k], braced_now.J[k]);
+    EXPECT_EQ(earlier_braced.bias[k], braced_now.bias[k]);
+    EXPECT_EQ(empty_qdot.J[k], braced_now.J[k]);
   }
 }
 
