@@ -91,7 +91,7 @@ void registerMassMatrix(const std::string& robot, const std::string& urdf)
     const drb::SceneState current = queries->initialState();
     for (auto _ : st)
     {
-      drb::MassMatrixAnswer answer;  // LocalScene::getMassMatrix: a fresh answer per call
+      drb::MassMatrixAnswer answer;  // _local Scene.get_mass_matrix: a fresh answer per call
       queries->massMatrices(current, {}, *q, false, answer);
       benchmark::DoNotOptimize(answer.mass_matrices.data());
     }
@@ -119,7 +119,7 @@ void registerBackprop(std::size_t K, std::size_t N)
     const drb::SceneState current = queries->initialState();
     for (auto _ : st)
     {
-      std::vector<double> gradient;  // LocalScene::backprop: a fresh answer per call
+      std::vector<double> gradient;  // _local Scene.backprop: a fresh answer per call
       queries->backpropConfigurations(current, body_name, *vertices, drb::DoubleView(gradients.get(), size), *q,
                                       gradient);
       benchmark::DoNotOptimize(gradient.data());

@@ -7,7 +7,7 @@ From each .srv's declaration (diff_rigid_body.service_fields), in the order of t
                                       benchmark only), `none` for a benchmark-only service's methods
     DRB_<Type>_RESPONSE_FIELDS(X)   X(C++ type, name) for each response field but success, message
                                     (services whose response fields are all plain values or arrays)
-    DRB_<Type>_REQUEST_FIELDS(X)    X(C++ type, name) for each request field (the same services)
+    DRB_<Type>_REQUEST_FIELDS(X)    X(C++ type, name) for each request field (core services only)
     DRB_CORE_SERVICES(X)            X(Type, name, node handler, SceneQueries member, answer struct)
                                     for the services whose declaration names a core member
     DRB_SHARDED_SERVICES(X)         X(Type, (&Request::field, ...), (&Response::field, ...)) for the
@@ -15,7 +15,8 @@ From each .srv's declaration (diff_rigid_body.service_fields), in the order of t
 
 The header is ROS-free (macros only): the node advertises from the first (services.h), the core
 declares its answer structs with the second, the node, the in-process module and the fuzz target
-bind the core members from the third and fourth, the C++ pool (pool_shards.h) shards with the
+bind the core members and the C++ client builds their requests (client_requests.h) from the
+third and fourth, the C++ pool (pool_shards.h) shards with the
 last. It is rewritten only when its text changes.
 """
 import importlib.util

@@ -1,5 +1,6 @@
 // Frame and centre-of-mass Jacobians for RigidBodyClient (rigid_body_client.h) and RigidBodyPool
-// (rigid_body_pool.h): the result types, the requests and the responses' split per frame or body.
+// (rigid_body_pool.h): the result types and the responses' split per frame or body (requests:
+// detail::requestOf, client_requests.h).
 //
 // Columns are d/dx' of the body's coordinates x (for a floating root: the Euler-angle rates). A
 // frame's six rows are linear [m/s] then angular [rad/s] per unit rate, in the reference asked for,
