@@ -11,12 +11,15 @@
 //
 // The earlier overloads deduce the type of their first moved argument, so that a braced list
 // there ({} for all bodies) never selects them: `inverseDynamics({}, q)` is the current order.
-// Braced frame names in the earlier place, `frameJacobians(body, q, {"link"})`, select the
-// earlier order (an array of at least one name); `{}` and braced numbers there are qdot.
+// Braced frame names in the earlier place, `frameJacobians(body, q, {"a", "b"})`, select the
+// earlier order: a braced list converts to std::initializer_list<Name> before anything else
+// (and two names would otherwise be an iterator pair for qdot's vector). Its Name is deduced, so
+// `{}` and braced numbers there stay qdot; names of mixed types take the array overload.
 // A CRTP base of EigenBatches (client_batches.h).
 #pragma once
 
 #include <cstddef>
+#include <initializer_list>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -83,6 +86,15 @@ public:
                  bool acceleration_bias = false)
   {
     return derived().frameJacobians(body, q, qdot, frames, reference, acceleration_bias);
+  }
+  template <typename Name, std::enable_if_t<std::is_convertible<const Name&, std::string>::value, int> = 0>
+  [[deprecated("frameJacobians(body, q, qdot, frames, reference, ...): qdot comes before frames now")]] FrameJacobians
+  frameJacobians(const std::string& body, const std::vector<double>& q, std::initializer_list<Name> frames,
+                 FrameReference reference = FrameReference::LocalWorldAligned, const std::vector<double>& qdot = {},
+                 bool acceleration_bias = false)
+  {
+    return derived().frameJacobians(body, q, qdot, std::vector<std::string>(frames.begin(), frames.end()), reference,
+                                    acceleration_bias);
   }
   template <std::size_t N>
   [[deprecated("frameJacobians(body, q, qdot, frames, reference, ...): qdot comes before frames now")]] FrameJacobians

@@ -175,10 +175,20 @@ TEST(CppClient, BatchedCallsTakeOneEigenVectorPerConfiguration)
   const std::vector<std::string> frames = client.frameJacobians("knot", flat).frames;
   const auto earlier_frames = client.frameJacobians("knot", flat, frames, World, flat_qdot, true);
   const auto earlier_braced = client.frameJacobians("knot", flat, { "knot" }, World, flat_qdot, true);
+  // Two names would fit qdot's iterator-pair constructor as well: the names must win.
+  const auto earlier_two = client.frameJacobians("knot", flat, { "knot", "knot" });
+  const std::string knot = "knot";
+  const auto earlier_mixed = client.frameJacobians("knot", flat, { knot, "knot" });
 #pragma GCC diagnostic pop
   const auto frames_now = client.frameJacobians("knot", flat, flat_qdot, frames, World, true);
   const auto braced_now = client.frameJacobians("knot", flat, flat_qdot, { "knot" }, World, true);
   const auto empty_qdot = client.frameJacobians("knot", flat, {}, { "knot" }, World);  // {} is qdot: the current order
+  const auto two_now = client.frameJacobians("knot", flat, {}, { "knot", "knot" });
+  ASSERT_EQ(two_now.frames.size(), 2u);
+  ASSERT_EQ(earlier_two.frames, two_now.frames);
+  ASSERT_EQ(earlier_mixed.frames, two_now.frames);
+  EXPECT_EQ(earlier_two.J, two_now.J);
+  EXPECT_EQ(earlier_mixed.J, two_now.J);
   ASSERT_EQ(earlier_braced.frames, std::vector<std::string>{ "knot" });
   ASSERT_EQ(empty_qdot.frames, std::vector<std::string>{ "knot" });
   for (std::size_t k = 0; k < 3; ++k)
