@@ -32,6 +32,14 @@ _spec.loader.exec_module(service_fields)
 CPP_TYPES = {'bool': 'bool', 'string': 'std::string', 'uint8': 'std::uint8_t', 'uint32': 'std::uint32_t',
              'int32': 'std::int32_t', 'float32': 'float', 'float64': 'double'}
 STATUS_FIELDS = ('success', 'message')
+#: The request field types a core service's bindings convert: the in-process module's LocalField and
+#: keyword (src/python/local_scene_queries.cpp) and the fuzz target's fuzzField.
+CORE_REQUEST_TYPES = ('string', 'string[]', 'float64[]', 'uint32[]', 'bool', 'uint8')
+#: The answer field types the in-process module's toPython converts.
+CORE_ANSWER_TYPES = ('string', 'string[]', 'float64[]', 'float32[]', 'uint32[]', 'int32[]', 'uint32')
+#: Names the binding macros use for their own locals, so no request field may take them:
+#: rigid_body_server.cpp, local_scene_queries.cpp, fuzz_declared_services.h, client_requests.h.
+BINDING_NAMES = ('answer', 'current', 'in', 'index', 'r', 'request', 'response', 'self', 'service', 'srv')
 WIDTH = 118  # the column of the line continuations
 
 
@@ -60,12 +68,29 @@ def response_macro(service, response):
     return fields_macro('DRB_%s_RESPONSE_FIELDS(X)' % service, [f for f in response if f.name not in STATUS_FIELDS])
 
 
+def check_core_fields(service, request, response):
+    """Refuses, naming the field, what a core service's bindings cannot pass or convert."""
+    answer = [f for f in response if f.name not in STATUS_FIELDS]
+    for part, fields, types in (('request', request, CORE_REQUEST_TYPES), ('response', answer, CORE_ANSWER_TYPES)):
+        for f in fields:
+            if f.type not in types:
+                raise ValueError('%s.srv: %s field %s %s: a core service\'s %s fields are of the types %s'
+                                 % (service, part, f.type, f.name, part, ', '.join(types)))
+    if not answer:
+        raise ValueError('%s.srv: a core service answers with at least one field beside success and message'
+                         % service)
+    for f in request:
+        if f.name in BINDING_NAMES or f.name.endswith('_held'):
+            raise ValueError('%s.srv: request field %s: the bindings use that name (%s, *_held)'
+                             % (service, f.name, ', '.join(BINDING_NAMES)))
+
+
 def core_row(service, declaration, request, response):
-    """The DRB_CORE_SERVICES row of a service answered by a core member, and its request macro."""
-    request_macro = fields_macro('DRB_%s_REQUEST_FIELDS(X)' % service, request)
-    if not request_macro or not response_macro(service, response):
-        raise ValueError('%s: a core service needs plain request and response fields (%s)'
-                         % (service, ', '.join(CPP_TYPES)))
+    """The DRB_CORE_SERVICES row of a service answered by a core member, and its request macro
+    (X per request field; none for a request without fields)."""
+    check_core_fields(service, request, response)
+    request_macro = (fields_macro('DRB_%s_REQUEST_FIELDS(X)' % service, request) if request
+                     else macro('DRB_%s_REQUEST_FIELDS(X)' % service, []))
     return 'X(%s, %s, %s, %s, %s)' % (service, declaration.name, camel_case(declaration.name), declaration.core,
                                       declaration.answer), request_macro
 

@@ -8,8 +8,8 @@ the SceneQueries member that answers it and that member's answer struct:
     # [service] ~get_mass_matrix; Python: mass_matrix; C++: massMatrices; core: massMatrices -> MassMatrixAnswer
     # [service] ~ping; benchmark only (advertised with ~benchmark_services:=true)
 
-A core member takes (the current state, the request fields in the .srv's order, the answer), and
-the answer struct holds the response fields but success and message. From that the node's
+A core member takes (the current state, the request fields in the .srv's order and under their
+names, the answer), and the answer struct holds the response fields but success and message. From that the node's
 handler, the in-process module's method (``diff_rigid_body._local``) and the fuzz target's call
 follow (``DRB_CORE_SERVICES`` in ``service_tables.h``).
 
@@ -44,15 +44,20 @@ Field = collections.namedtuple('Field', 'type name per_configuration')
 Declaration = collections.namedtuple('Declaration', 'name python cpp benchmark_only core answer')
 
 _DECLARATION = re.compile(r'^#\s*\[service\]\s*~(\w+)\s*;\s*(?:Python:\s*(\w+)\s*;\s*C\+\+:\s*(\w+)'
-                          r'(?:\s*;\s*core:\s*(\w+)\s*->\s*(\w+))?|(benchmark only))')
+                          r'(?:\s*;\s*core:\s*(\w+)\s*->\s*(\w+))?|(benchmark only)(?:\s*\([^)\n]*\))?)[ \t]*(?:\n|$)')
+_DECLARATION_MARK = re.compile(r'^#\s*\[service\]')
 _FIELD = re.compile(r'^\s*([A-Za-z_][\w/]*(?:\[\d*\])?)\s+([A-Za-z_]\w*)\s*(?:#\s*(.*))?$')
 
 
 def parse_declaration(text):
     """The :data:`Declaration` on the first line of a .srv text (or of a request's
-    ``_full_text``), or None when it has none."""
-    match = _DECLARATION.match(text.lstrip())
+    ``_full_text``), or None when it has none; ValueError for a first line that begins as a
+    declaration but does not follow the form above."""
+    text = text.lstrip()
+    match = _DECLARATION.match(text)
     if match is None:
+        if _DECLARATION_MARK.match(text):
+            raise ValueError('not a service declaration (see service_fields.py): %r' % text.split('\n', 1)[0])
         return None
     name, python, cpp, core, answer, benchmark_only = match.groups()
     return Declaration(name, python, cpp, benchmark_only is not None, core, answer)

@@ -76,8 +76,8 @@ private:
 
 /// Binds, as methods of `scene` named after their services, the services a core member answers
 /// (DRB_CORE_SERVICES, from each .srv's declaration): the request fields in the .srv's order as
-/// arguments (float64[] and uint32[] as numpy arrays, bools and uint8 with the default 0), the
-/// response fields as the dict's entries.
+/// keyword arguments (float64[] and uint32[] as numpy arrays; each defaults as an unset ROS request
+/// field: empty, 0 or false, and an empty q is refused), the response fields as the dict's entries.
 void bindCoreServices(py::class_<LocalScene>& scene);
 
 }  // namespace python

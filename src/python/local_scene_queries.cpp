@@ -2,8 +2,10 @@
 // service calls (src/node/rigid_body_server.cpp), with the GIL released, and moves the answer's
 // arrays into numpy (adopt) under the response's field names (the answer's field list). The
 // services a core member answers are bound from their declarations (DRB_CORE_SERVICES).
+#include <cstdint>
 #include <cstring>
 #include <optional>
+#include <string>
 
 #include <pybind11/stl.h>
 
@@ -76,19 +78,25 @@ struct LocalField<std::vector<std::uint32_t>>
   static const std::vector<std::uint32_t>& pass(const std::vector<std::uint32_t>& values) { return values; }
 };
 
-/// The keyword argument of a request field: required, but for flags and small enumerations (0).
+template <>
+struct LocalField<std::uint8_t>
+{
+  using Input = std::int64_t;  // any Python int that fits: out of 0..255 is refused, not a TypeError
+  static std::uint8_t hold(Input value, const char* field, const char* service)
+  {
+    if (value < 0 || value > 255)
+      throw Refusal{ service, std::string(field) + ": " + std::to_string(value) + " is not a uint8 (0..255)" };
+    return static_cast<std::uint8_t>(value);
+  }
+  static std::uint8_t pass(std::uint8_t value) { return value; }
+};
+
+/// The keyword argument of a request field, defaulting as a ROS request leaves a field unset:
+/// empty arrays and names, 0, false (an empty q is then refused: LocalField, requiredQ).
 template <typename T>
-py::arg keyword(const char* name, const T*)
+py::arg_v keyword(const char* name, const T*)
 {
-  return py::arg(name);
-}
-py::arg_v keyword(const char* name, const bool*)
-{
-  return py::arg_v(name, false);
-}
-py::arg_v keyword(const char* name, const std::uint8_t*)
-{
-  return py::arg_v(name, 0);
+  return py::arg_v(name, typename LocalField<T>::Input{});
 }
 
 // A response field as Python: numeric vectors handed to numpy (adopt), names as a list, scalars.
@@ -172,6 +180,12 @@ void bindCoreServices(py::class_<LocalScene>& scene)
 {
   DRB_CORE_SERVICES(DRB_BIND_CORE)
 }
+#undef DRB_BIND_CORE
+#undef DRB_LOCAL_KEYWORD
+#undef DRB_LOCAL_PASS
+#undef DRB_LOCAL_HOLD
+#undef DRB_LOCAL_INPUT
+#undef DRB_PYTHON_FIELD
 
 }  // namespace python
 }  // namespace diff_rigid_body

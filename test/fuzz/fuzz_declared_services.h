@@ -91,6 +91,7 @@ inline void requireFiniteField(const std::vector<double>& values, const char* fi
 
 /// How many services DRB_CORE_SERVICES declares.
 constexpr int kDeclaredServices = 0 DRB_CORE_SERVICES(DRB_FUZZ_COUNT);
+static_assert(kDeclaredServices > 0, "DRB_CORE_SERVICES declares no service to fuzz");
 
 /// One request to a declared service, picked by the input.
 inline void declaredServiceRequest(FuzzedDataProvider& in, const diff_rigid_body::SceneState& current)

@@ -133,6 +133,11 @@ class LocalSceneAgainstNode(unittest.TestCase):
         nan[2] = np.nan
         self.assert_same_refusal(local, node, 'forward_dynamics', nan)
         self.assert_same_refusal(local, node, 'backprop', bodies.names[0], np.zeros((3, 3)), q, vertices=[0, 1, 10**7])
+        self.assert_same_refusal(local, node, 'call', 'get_frame_jacobians', body=bodies.names[0], q=q, reference=3)
+        for reference in (256, -1):  # not a uint8: the node's client cannot send it, the local scene refuses it
+            with self.assertRaises(DiffRigidBodyError) as refusal:
+                local.call('get_frame_jacobians', body=bodies.names[0], q=q, reference=reference)
+            self.assertIn('reference: %d is not a uint8' % reference, refusal.exception.message)
 
     def test_e_q_is_required(self):
         local, _, bodies = self.pairs['scene']

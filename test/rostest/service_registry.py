@@ -23,7 +23,9 @@ a .srv field without its "[per configuration]" marker would silently stop being 
 instances.
 Every service a core member answers (DRB_CORE_SERVICES, `core:` in its declaration) declares its
 answer struct in scene_queries.h from its own response fields, so that the node and the in-process
-module move exactly the response's fields; the node answers the others itself, and the in-process
+module move exactly the response's fields, and its SceneQueries member takes the request's fields
+under their names and in the .srv's order (every binding passes them by position); the node
+answers the others itself, and the in-process
 module (_local.SERVICES) answers exactly the core services, get_bodies and
 get_vertex_jacobians_compact.
 GetBodies.srv and BodyState.msg comment every field in the user's terms, `rossrv show -r` prints the
@@ -40,6 +42,7 @@ import rosgraph
 import rospkg
 import rostest
 
+from diff_rigid_body import service_fields
 from diff_rigid_body.client import RigidBodyClient
 from diff_rigid_body.pool_shards import SHARDED
 
@@ -237,6 +240,24 @@ class ServiceRegistry(unittest.TestCase):
         from diff_rigid_body import _local
         self.assertEqual(set(_local.SERVICES),
                          {name for _, name, _, _, _ in rows} | {'get_bodies', 'get_vertex_jacobians_compact'})
+
+    def test_core_members_take_the_request_fields_in_srv_order(self):
+        """The node, the in-process module, the fuzz target and the C++ client pass a core
+        service's request fields by position: the member's parameters must be the .srv's request
+        fields, named alike and in the same order (two fields of one type could swap unseen)."""
+        text = generated_service_tables()
+        table = text[text.index('#define DRB_CORE_SERVICES'):]
+        header = read('include', PKG, 'services', 'scene_queries.h')
+        for srv, name, _, member, answer in CORE_ROW.findall(table[:table.index('\n\n')]):
+            pattern = r'void %s\(const SceneState& current,\s*([^;{]*),\s*%s& answer\) const' % (member, answer)
+            declared = re.search(pattern, header)
+            self.assertIsNotNone(declared, '~%s: no SceneQueries::%s(current, ..., %s& answer)'
+                                 % (name, member, answer))
+            parameters = [re.search(r'(\w+)\s*$', p).group(1) for p in declared.group(1).split(',')]
+            request, _ = service_fields.parse_service(read('srv', srv + '.srv'))
+            self.assertEqual(parameters, [f.name for f in request],
+                             '~%s: SceneQueries::%s\'s parameters against %s.srv\'s request fields'
+                             % (name, member, srv))
 
     def test_readme_services_table(self):
         rows = table_keys(markdown_section(read('README.md'), '### Services'), r'`~(\w+)`')

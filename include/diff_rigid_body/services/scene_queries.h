@@ -196,15 +196,15 @@ public:
   /// body(index).links order (tf): linkPoses of kinematics.h.
   void linkPoses(std::size_t index, const Eigen::VectorXd& x, std::vector<Eigen::Isometry3d>& poses) const;
 
-  /// M(x), and dM/dx when `derivatives`, for the bodies `names` (empty = all)
+  /// M(x), and dM/dx when `derivatives`, for the bodies `bodies` (empty = all)
   /// at K configurations given in `q` (each the concatenation of the listed
   /// bodies' x: K D values, D = sum of their d), or at `current` when `q` is
   /// empty. At most RequestLimits::kMaxMassMatrixDoubles answer doubles
   /// (...WithDerivatives when `derivatives`). `answer` is overwritten (its
   /// buffers reused); on refusal it holds no answer.
-  void massMatrices(const SceneState& current, const std::vector<std::string>& names, DoubleView q,
+  void massMatrices(const SceneState& current, const std::vector<std::string>& bodies, DoubleView q,
                     bool derivatives, MassMatrixAnswer& answer) const;
-  MassMatrixAnswer massMatrices(const SceneState& current, const std::vector<std::string>& names,
+  MassMatrixAnswer massMatrices(const SceneState& current, const std::vector<std::string>& bodies,
                                 DoubleView q, bool derivatives) const;
 
   /// Positions (3 per vertex, fixed frame) and Jacobians dp/dx (3 d per
@@ -268,24 +268,24 @@ public:
                            const std::vector<std::uint32_t>& vertices, DoubleView gradients,
                            DoubleView q) const;
 
-  /// Inverse dynamics of the bodies `names` (empty = all) at K
+  /// Inverse dynamics of the bodies `bodies` (empty = all) at K
   /// configurations (q: K D values, D the sum of their d; empty = the
   /// current state, K = 1), with qdot and qddot of q's length or empty
-  /// (zeros): tau, c and g, and with `coriolis` C, with `derivatives`
+  /// (zeros): tau, c and g, and with `coriolis_matrices` C, with `derivatives`
   /// dtau/dx and dtau/dx' (rnea.h, rnea_derivatives.h). Defined everywhere,
   /// gimbal lock included. Refused, before anything is computed: unknown
   /// bodies, lengths that do not match, non-finite values, answers over
   /// RequestLimits' budgets; after: a result that is not finite.
-  void inverseDynamics(const SceneState& current, const std::vector<std::string>& names,
+  void inverseDynamics(const SceneState& current, const std::vector<std::string>& bodies,
                        DoubleView q, DoubleView qdot,
-                       DoubleView qddot, bool coriolis, bool derivatives,
+                       DoubleView qddot, bool coriolis_matrices, bool derivatives,
                        InverseDynamicsAnswer& answer) const;
 
   /// Forward dynamics x'' (forward_dynamics.h), with `derivatives`
   /// dx''/dx, dx''/dx' and M^-1, laid out and checked as inverseDynamics
   /// (tau in place of qddot). A configuration where M is singular refuses the
   /// whole request, naming the body, the configuration and why.
-  void forwardDynamics(const SceneState& current, const std::vector<std::string>& names,
+  void forwardDynamics(const SceneState& current, const std::vector<std::string>& bodies,
                        DoubleView q, DoubleView qdot, DoubleView tau,
                        bool derivatives, ForwardDynamicsAnswer& answer) const;
 
@@ -305,10 +305,10 @@ public:
                       DoubleView q, DoubleView qdot, std::uint32_t reference,
                       bool acceleration_bias, FrameJacobianAnswer& answer) const;
 
-  /// Centre of mass of the bodies `names` (empty = all), and with
+  /// Centre of mass of the bodies `bodies` (empty = all), and with
   /// `jacobians` its Jacobian and acceleration bias, laid out and checked as
   /// inverseDynamics (qdot in place of qddot); a massless body is refused.
-  void centerOfMass(const SceneState& current, const std::vector<std::string>& names, DoubleView q,
+  void centerOfMass(const SceneState& current, const std::vector<std::string>& bodies, DoubleView q,
                     DoubleView qdot, bool jacobians, CenterOfMassAnswer& answer) const;
 
   /// This thread's workspace for body `index`, made on first use and kept

@@ -55,23 +55,23 @@ std::string singularReason(const BodyModel& body, const double* x, int coordinat
 
 }  // namespace
 
-void SceneQueries::inverseDynamics(const SceneState& current, const std::vector<std::string>& names,
+void SceneQueries::inverseDynamics(const SceneState& current, const std::vector<std::string>& bodies,
                                    DoubleView q, DoubleView qdot,
-                                   DoubleView qddot, bool coriolis, bool derivatives,
+                                   DoubleView qddot, bool coriolis_matrices, bool derivatives,
                                    InverseDynamicsAnswer& answer) const
 {
   const detail::BatchedBodies batch =
-      detail::batchedBodies(*this, names, q, { { "qdot", &qdot }, { "qddot", &qddot } });
+      detail::batchedBodies(*this, bodies, q, { { "qdot", &qdot }, { "qddot", &qddot } });
   const std::vector<std::size_t>& indices = batch.indices;
   const detail::RequestLayout& layout = batch.layout;
   const std::size_t K = batch.K, n = indices.size();
-  const std::size_t matrices = (coriolis ? 1 : 0) + (derivatives ? 2 : 0);
+  const std::size_t matrices = (coriolis_matrices ? 1 : 0) + (derivatives ? 2 : 0);
   checkDynamicsBudget(K, 3 * layout.D + matrices * layout.per_m + n, matrices > 0);
   setBodies(*this, indices, answer);
   answer.tau.resize(K * layout.D);
   answer.velocity_terms.resize(K * layout.D);
   answer.gravity_terms.resize(K * layout.D);
-  answer.coriolis_matrices.resize(coriolis ? K * layout.per_m : 0);
+  answer.coriolis_matrices.resize(coriolis_matrices ? K * layout.per_m : 0);
   answer.dtau_dq.resize(derivatives ? K * layout.per_m : 0);
   answer.dtau_dqdot.resize(derivatives ? K * layout.per_m : 0);
   forEachBodySlot(*this, layout, indices, K, current, q, answer.cos_theta, [&](const detail::BodySlot& slot) {
@@ -80,7 +80,7 @@ void SceneQueries::inverseDynamics(const SceneState& current, const std::vector<
     inverseDynamicsTerms(scene_.bodies[slot.body], ws, slot.x, slice(qdot, v), slice(qddot, v), gravity_,
                          answer.tau.data() + v, answer.velocity_terms.data() + v, answer.gravity_terms.data() + v,
                          matrices > 0 ? &ws.derivative_x : nullptr, &ws.derivative_xd);
-    if (coriolis)
+    if (coriolis_matrices)
       writeRowMajor(ws.derivative_xd, 0.5, answer.coriolis_matrices.data() + m);
     if (derivatives)
     {
@@ -96,12 +96,12 @@ void SceneQueries::inverseDynamics(const SceneState& current, const std::vector<
                          { "result dtau_dqdot", &answer.dtau_dqdot } });
 }
 
-void SceneQueries::forwardDynamics(const SceneState& current, const std::vector<std::string>& names,
+void SceneQueries::forwardDynamics(const SceneState& current, const std::vector<std::string>& bodies,
                                    DoubleView q, DoubleView qdot,
                                    DoubleView tau, bool derivatives,
                                    ForwardDynamicsAnswer& answer) const
 {
-  const detail::BatchedBodies batch = detail::batchedBodies(*this, names, q, { { "qdot", &qdot }, { "tau", &tau } });
+  const detail::BatchedBodies batch = detail::batchedBodies(*this, bodies, q, { { "qdot", &qdot }, { "tau", &tau } });
   const std::vector<std::size_t>& indices = batch.indices;
   const detail::RequestLayout& layout = batch.layout;
   const std::size_t K = batch.K, n = indices.size();

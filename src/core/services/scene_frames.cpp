@@ -217,11 +217,11 @@ void SceneQueries::frameJacobians(const SceneState& current, const std::string& 
                          { "result acceleration_bias", &answer.acceleration_bias } });
 }
 
-void SceneQueries::centerOfMass(const SceneState& current, const std::vector<std::string>& names,
+void SceneQueries::centerOfMass(const SceneState& current, const std::vector<std::string>& bodies,
                                 DoubleView q, DoubleView qdot, bool jacobians,
                                 CenterOfMassAnswer& answer) const
 {
-  const detail::BatchedBodies batch = detail::batchedBodies(*this, names, q, { { "qdot", &qdot } });
+  const detail::BatchedBodies batch = detail::batchedBodies(*this, bodies, q, { { "qdot", &qdot } });
   const std::vector<std::size_t>& indices = batch.indices;
   const detail::RequestLayout& layout = batch.layout;
   const std::size_t K = batch.K, n = indices.size();

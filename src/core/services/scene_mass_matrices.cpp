@@ -15,11 +15,11 @@ namespace diff_rigid_body
 using detail::reject;
 using detail::sizeMismatch;
 
-void SceneQueries::massMatrices(const SceneState& current, const std::vector<std::string>& names,
+void SceneQueries::massMatrices(const SceneState& current, const std::vector<std::string>& bodies,
                                 DoubleView q, bool derivatives, MassMatrixAnswer& answer) const
 {
   thread_local std::vector<std::size_t> indices;  // reused: no allocation per call in steady state
-  bodyIndices(names, "bodies", indices);
+  bodyIndices(bodies, "bodies", indices);
   const std::size_t n = indices.size();
   const detail::RequestLayout& layout = detail::requestLayout(*this, indices);
   std::size_t configurations = 1;
@@ -80,11 +80,11 @@ void SceneQueries::massMatrices(const SceneState& current, const std::vector<std
   answer = std::move(result);
 }
 
-MassMatrixAnswer SceneQueries::massMatrices(const SceneState& current, const std::vector<std::string>& names,
+MassMatrixAnswer SceneQueries::massMatrices(const SceneState& current, const std::vector<std::string>& bodies,
                                             DoubleView q, bool derivatives) const
 {
   MassMatrixAnswer answer;
-  massMatrices(current, names, q, derivatives, answer);
+  massMatrices(current, bodies, q, derivatives, answer);
   return answer;
 }
 
