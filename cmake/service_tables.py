@@ -21,6 +21,7 @@ last. It is rewritten only when its text changes.
 """
 import importlib.util
 import os
+import re
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -39,7 +40,10 @@ CORE_REQUEST_TYPES = ('string', 'string[]', 'float64[]', 'uint32[]', 'bool', 'ui
 CORE_ANSWER_TYPES = ('string', 'string[]', 'float64[]', 'float32[]', 'uint32[]', 'int32[]', 'uint32')
 #: Names the binding macros use for their own locals, so no request field may take them:
 #: rigid_body_server.cpp, local_scene_queries.cpp, fuzz_declared_services.h, client_requests.h.
-BINDING_NAMES = ('answer', 'current', 'in', 'index', 'r', 'request', 'response', 'self', 'service', 'srv')
+#: (Request field names are lower_case, so the bindings' camelCase helpers cannot clash either.)
+BINDING_NAMES = ('answer', 'current', 'in', 'index', 'queries', 'r', 'request', 'response', 'self', 'serve', 'service',
+                 'srv')
+LOWER_CASE = re.compile(r'^[a-z][a-z0-9_]*$')
 WIDTH = 118  # the column of the line continuations
 
 
@@ -53,7 +57,7 @@ def cpp_type(ros_type):
 
 def macro(name, lines):
     body = ['#define %s' % name] + ['  %s' % line for line in lines]
-    return '\n'.join(text.ljust(WIDTH) + ' \\' for text in body[:-1]) + '\n' + body[-1] + '\n'
+    return ''.join(text.ljust(WIDTH) + ' \\\n' for text in body[:-1]) + body[-1] + '\n'
 
 
 def fields_macro(name, fields):
@@ -80,9 +84,9 @@ def check_core_fields(service, request, response):
         raise ValueError('%s.srv: a core service answers with at least one field beside success and message'
                          % service)
     for f in request:
-        if f.name in BINDING_NAMES or f.name.endswith('_held'):
-            raise ValueError('%s.srv: request field %s: the bindings use that name (%s, *_held)'
-                             % (service, f.name, ', '.join(BINDING_NAMES)))
+        if f.name in BINDING_NAMES or f.name.endswith('_held') or not LOWER_CASE.match(f.name):
+            raise ValueError('%s.srv: request field %s: a core service\'s request fields are lower_case and not '
+                             'named as the bindings\' locals (%s, *_held)' % (service, f.name, ', '.join(BINDING_NAMES)))
 
 
 def core_row(service, declaration, request, response):

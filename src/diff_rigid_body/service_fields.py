@@ -9,9 +9,9 @@ the SceneQueries member that answers it and that member's answer struct:
     # [service] ~ping; benchmark only (advertised with ~benchmark_services:=true)
 
 A core member takes (the current state, the request fields in the .srv's order and under their
-names, the answer), and the answer struct holds the response fields but success and message. From that the node's
-handler, the in-process module's method (``diff_rigid_body._local``) and the fuzz target's call
-follow (``DRB_CORE_SERVICES`` in ``service_tables.h``).
+names, the answer), and the answer struct holds the response fields but success and message.
+From that the node's handler, the in-process module's method (``diff_rigid_body._local``) and
+the fuzz target's call follow (``DRB_CORE_SERVICES`` in ``service_tables.h``).
 
 The node advertises every declared service (``DIFF_RIGID_BODY_SERVICES`` in ``services.h``, from
 ``service_tables.h``), the Python client holds those with a Python method in its ``SERVICES``, and
@@ -44,7 +44,7 @@ Field = collections.namedtuple('Field', 'type name per_configuration')
 Declaration = collections.namedtuple('Declaration', 'name python cpp benchmark_only core answer')
 
 _DECLARATION = re.compile(r'^#\s*\[service\]\s*~(\w+)\s*;\s*(?:Python:\s*(\w+)\s*;\s*C\+\+:\s*(\w+)'
-                          r'(?:\s*;\s*core:\s*(\w+)\s*->\s*(\w+))?|(benchmark only)(?:\s*\([^)\n]*\))?)[ \t]*(?:\n|$)')
+                          r'(?:\s*;\s*core:\s*(\w+)\s*->\s*(\w+))?|(benchmark only)(?:\s*\([^)\n]*\))?)[ \t\r]*(?:\n|$)')
 _DECLARATION_MARK = re.compile(r'^#\s*\[service\]')
 _FIELD = re.compile(r'^\s*([A-Za-z_][\w/]*(?:\[\d*\])?)\s+([A-Za-z_]\w*)\s*(?:#\s*(.*))?$')
 

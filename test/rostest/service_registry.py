@@ -249,11 +249,11 @@ class ServiceRegistry(unittest.TestCase):
         table = text[text.index('#define DRB_CORE_SERVICES'):]
         header = read('include', PKG, 'services', 'scene_queries.h')
         for srv, name, _, member, answer in CORE_ROW.findall(table[:table.index('\n\n')]):
-            pattern = r'void %s\(const SceneState& current,\s*([^;{]*),\s*%s& answer\) const' % (member, answer)
+            pattern = r'void %s\(const SceneState& current((?:,[^;{,]+)*),\s*%s& answer\) const' % (member, answer)
             declared = re.search(pattern, header)
             self.assertIsNotNone(declared, '~%s: no SceneQueries::%s(current, ..., %s& answer)'
                                  % (name, member, answer))
-            parameters = [re.search(r'(\w+)\s*$', p).group(1) for p in declared.group(1).split(',')]
+            parameters = [re.search(r'(\w+)\s*$', p).group(1) for p in declared.group(1).split(',')[1:]]
             request, _ = service_fields.parse_service(read('srv', srv + '.srv'))
             self.assertEqual(parameters, [f.name for f in request],
                              '~%s: SceneQueries::%s\'s parameters against %s.srv\'s request fields'
