@@ -77,6 +77,40 @@ void jointTrigonometry(const BodyModel& model, BodyWorkspace<Scalar>& ws, const 
   }
 }
 
+/// jointTrigonometry for the revolute segments s with needed[s] != 0 and a
+/// free root's angles; the other revolute slots are stale. The needed angles
+/// are gathered to the front of ws.joint_angle, done by one sinCos, and
+/// scattered back to their slots from the last (a slot is never before its
+/// compact index, so nothing is overwritten before it is read).
+inline void neededJointTrigonometry(const BodyModel& model, BodyWorkspace<double>& ws, const double* x,
+                                    const std::vector<char>& needed)
+{
+  const std::size_t revolute = model.revolute_segments.size();
+  std::size_t count = 0;
+  for (std::size_t k = 0; k < revolute; ++k)
+  {
+    const std::size_t s = static_cast<std::size_t>(model.revolute_segments[k]);
+    if (needed[s])
+      ws.joint_angle[count++] = jointValue(model, model.segments[s], x);
+  }
+  if (model.hasFreeRoot())
+    for (int k = 0; k < 3; ++k)
+      ws.joint_angle[count++] = x[PHI + k];
+  sinCos(ws.joint_angle.data(), count, ws.joint_sine.data(), ws.joint_cosine.data());
+  std::size_t compact = count;
+  const auto move_to = [&](std::size_t slot) {
+    --compact;
+    ws.joint_sine[slot] = ws.joint_sine[compact];
+    ws.joint_cosine[slot] = ws.joint_cosine[compact];
+  };
+  if (model.hasFreeRoot())
+    for (int k = 2; k >= 0; --k)
+      move_to(revolute + static_cast<std::size_t>(k));
+  for (std::size_t k = revolute; k-- > 0 && compact > 0;)
+    if (needed[static_cast<std::size_t>(model.revolute_segments[k])])
+      move_to(k);
+}
+
 /// R Rot(axis, angle) from its sine and cosine: for axis = +-e_k only two
 /// columns change (i, j, k cyclic, sigma = axis_k):
 ///   col_i' = c col_i + sigma s col_j,   col_j' = c col_j - sigma s col_i;
@@ -165,11 +199,11 @@ void placeFreeRoot(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Scal
 namespace detail
 {
 /// The root and every later segment s with needed(s) placed at x (a set
-/// closed under parents: a needed segment's parent is needed).
+/// closed under parents: a needed segment's parent is needed), from the
+/// sines and cosines in ws (jointTrigonometry of at least those segments).
 template <typename Scalar, typename Needed>
 void placeSegments(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Scalar* x, Needed&& needed)
 {
-  jointTrigonometry(model, ws, x);
   const Segment& root = model.segments[0];
   if (root.joint_type == JointType::Free)
     placeFreeRoot(model, ws, x);
@@ -191,7 +225,7 @@ void placeSegments(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Scal
       placeJointSegment(model, ws, s, Matrix3<Scalar>(ws.R[parent] * segment.placement_rotation.template cast<Scalar>()),
                         pj, x);
     else
-      placeJointSegment(model, ws, s, Matrix3<Scalar>(ws.R[parent]), pj, x);
+      placeJointSegment(model, ws, s, ws.R[parent], pj, x);  // writes ws.R[s] only: no alias
   }
 }
 }  // namespace detail
@@ -201,6 +235,7 @@ void placeSegments(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Scal
 template <typename Scalar>
 void forwardKinematics(const BodyModel& model, BodyWorkspace<Scalar>& ws, const Scalar* x)
 {
+  detail::jointTrigonometry(model, ws, x);
   detail::placeSegments(model, ws, x, [](std::size_t) { return true; });
 }
 
@@ -210,6 +245,7 @@ void forwardKinematics(const BodyModel& model, BodyWorkspace<Scalar>& ws, const 
 inline void forwardKinematicsOf(const BodyModel& model, BodyWorkspace<double>& ws, const double* x,
                                 const std::vector<char>& needed)
 {
+  detail::neededJointTrigonometry(model, ws, x, needed);
   detail::placeSegments(model, ws, x, [&](std::size_t s) { return needed[s] != 0; });
 }
 

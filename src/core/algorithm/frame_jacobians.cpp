@@ -4,22 +4,11 @@
 
 #include "diff_rigid_body/algorithm/crba.h"
 #include "diff_rigid_body/algorithm/rnea.h"
-#include "algorithm/segment_columns.h"
 
 namespace diff_rigid_body
 {
 namespace
 {
-/// Every column of a body of d coordinates, in x order (this thread's, kept:
-/// nothing is allocated once a thread has seen d).
-const JacobianColumns& allColumns(const BodyModel& model)
-{
-  thread_local JacobianColumns columns;
-  if (columns.width != model.coordinates || columns.of_coordinate.size() != model.coordinates)
-    columns = JacobianColumns::all(model);
-  return columns;
-}
-
 /// The frame's pose (R_F, p_F): X_segment T(link_origin) X_link-in-segment.
 void framePose(const BodyModel& model, const BodyWorkspace<double>& ws, const LinkInBody& link, Matrix3<double>& R,
                Vector3<double>& p)
@@ -39,32 +28,45 @@ void writePose(const Matrix3<double>& R, const Vector3<double>& p, double* pose1
       pose12[3 + 3 * r + c] = R(r, c);
 }
 
-/// J_c = (V_c + W_c x (P - r), W_c) from the prepared columns, in fixed axes
-/// or, for LOCAL, in R's (6 x d row-major): zeros, then the columns of the
-/// dofs that segment s hangs from (the only nonzero ones).
+/// J_c = (V_c + W_c x (P - r), W_c) (6 x d row-major), written from the unit
+/// motions of the dofs that segment s hangs from (the only nonzero columns):
+/// dof k adds m_k (S_k.v + S_k.w x lever, S_k.w) to column c_k, in fixed axes
+/// or, for LOCAL, in R's. A free root's rotation dofs are motion coordinates,
+/// so its columns 0..2 are then turned by the chart: J_x = J_nu A, A = T there.
 void writeJacobian(const BodyModel& model, const BodyWorkspace<double>& ws, std::size_t s,
                    const Vector3<double>& lever, bool local, const Matrix3<double>& R, double* J)
 {
   const std::size_t d = model.coordinates;
   std::fill(J, J + 6 * d, 0.0);
-  const double* rows = ws.column_motion.data();
   const Segment& segment = model.segments[s];
   for (int k = segment.first_dof + segment.dof_count - 1; k >= 0; k = model.dofs[static_cast<std::size_t>(k)].parent)
   {
-    const std::size_t c = static_cast<std::size_t>(model.dofs[static_cast<std::size_t>(k)].coordinate);
-    const Vector3<double> W(rows[3 * d + c], rows[4 * d + c], rows[5 * d + c]);
-    Vector3<double> linear = Vector3<double>(rows[c], rows[d + c], rows[2 * d + c]) + W.cross(lever);
+    const Dof& dof = model.dofs[static_cast<std::size_t>(k)];
+    const Motion<double>& S = ws.S[static_cast<std::size_t>(k)];
+    const Vector3<double> W = dof.multiplier * S.w;
+    Vector3<double> linear = dof.multiplier * S.v + W.cross(lever);
     Vector3<double> angular = W;
     if (local)
     {
       linear = R.transpose() * linear;
       angular = R.transpose() * angular;
     }
+    const std::size_t c = static_cast<std::size_t>(dof.coordinate);
     for (int i = 0; i < 3; ++i)
     {
-      J[static_cast<std::size_t>(i) * d + c] = linear[i];
-      J[static_cast<std::size_t>(3 + i) * d + c] = angular[i];
+      J[static_cast<std::size_t>(i) * d + c] += linear[i];
+      J[static_cast<std::size_t>(3 + i) * d + c] += angular[i];
     }
+  }
+  if (!model.hasFreeRoot())
+    return;
+  const Matrix3<double>& T = ws.chart.T;
+  for (std::size_t i = 0; i < 6; ++i)
+  {
+    double* row = J + i * d;  // the rotation coordinates phi, theta, psi are x[0..2]
+    const double along[3] = { row[0], row[1], row[2] };
+    for (int c = 0; c < 3; ++c)
+      row[c] = along[0] * T(0, c) + along[1] * T(1, c) + along[2] * T(2, c);
   }
 }
 }  // namespace
@@ -94,10 +96,7 @@ void frameJacobian(const BodyModel& model, BodyWorkspace<double>& ws, std::size_
   const Vector3<double> lever = point - ws.r;
   const bool local = reference == FrameReference::Local;
   if (jacobian)
-  {
-    detail::prepareSegmentColumns(model, ws, allColumns(model), s);
     writeJacobian(model, ws, s, lever, local, R, jacobian);
-  }
   if (!bias)
     return;
   const Segment& segment = model.segments[s];

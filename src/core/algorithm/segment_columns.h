@@ -1,6 +1,6 @@
-// The columns (V_c, W_c) of dp/dx for the points of one segment: shared by
-// the vertex Jacobians (vertex_jacobians.cpp) and the frame Jacobians
-// (frame_jacobians.cpp). A point p of segment s moves at
+// The columns (V_c, W_c) of dp/dx for the points of one segment, for the
+// vertex Jacobians (vertex_jacobians.cpp; frame_jacobians.cpp writes the same
+// columns of its one point directly). A point p of segment s moves at
 //   dp/dx_c = V_c + W_c x (p - r),   (W_c; V_c) = (sum over the dofs k on s's
 // path that drive nu_c of m_k S_k) A,
 // A the chart (motion_coordinates.h): a free root's three rotation columns
