@@ -15,6 +15,8 @@
 // earlier order: a braced list converts to std::initializer_list<Name> before anything else
 // (and two names would otherwise be an iterator pair for qdot's vector). Its Name is deduced, so
 // `{}` and braced numbers there stay qdot; names of mixed types take the array overload.
+// Braced names followed by frames, `frameJacobians(body, q, {"a", "b"}, {"c"})`, fit neither order
+// and do not compile (a deleted overload), where the names would be qdot's iterator pair.
 // A CRTP base of EigenBatches (client_batches.h).
 #pragma once
 
@@ -96,6 +98,12 @@ public:
     return derived().frameJacobians(body, q, qdot, std::vector<std::string>(frames.begin(), frames.end()), reference,
                                     acceleration_bias);
   }
+  /// Braced names in qdot's place, then frames: refused at compile time.
+  template <typename Name, std::enable_if_t<std::is_convertible<const Name&, std::string>::value, int> = 0>
+  FrameJacobians frameJacobians(const std::string& body, const std::vector<double>& q,
+                                std::initializer_list<Name> names_as_qdot, const std::vector<std::string>& frames,
+                                FrameReference reference = FrameReference::LocalWorldAligned,
+                                bool acceleration_bias = false) = delete;
   template <std::size_t N>
   [[deprecated("frameJacobians(body, q, qdot, frames, reference, ...): qdot comes before frames now")]] FrameJacobians
   frameJacobians(const std::string& body, const std::vector<double>& q, const std::string (&frames)[N],

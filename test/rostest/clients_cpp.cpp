@@ -3,6 +3,7 @@
 // shapes, layout, errors, and a Gauss-Newton pose fit built on it.
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -10,6 +11,7 @@
 #include <ros/ros.h>
 
 #include "diff_rigid_body_ros/rigid_body_client.h"
+#include "diff_rigid_body_ros/rigid_body_pool.h"
 #include "../support/expect_throws.h"
 
 namespace
@@ -21,6 +23,34 @@ using diff_rigid_body_ros::Vector6d;
 constexpr double MATRIX_TOLERANCE = 1e-12;   // relative, of the largest entry
 constexpr double FD_TOLERANCE = 1e-7;        // m per unit of q (central differences, h = 1e-6)
 constexpr double FIT_TOLERANCE = 1e-8;       // rad and m
+
+// Whether `frameJacobians(body, q, {a, b}, {"c"})` compiles for Client, with {a, b} two names or two numbers.
+template <typename Client>
+constexpr auto accepts_names_as_qdot(int)
+    -> decltype(std::declval<Client&>().frameJacobians(std::string(), std::vector<double>(), { "a", "b" },
+                                                       std::vector<std::string>{ "c" }),
+                true)
+{
+  return true;
+}
+template <typename Client>
+constexpr bool accepts_names_as_qdot(long)
+{
+  return false;
+}
+template <typename Client>
+constexpr auto accepts_numbers_as_qdot(int)
+    -> decltype(std::declval<Client&>().frameJacobians(std::string(), std::vector<double>(), { 1.0, 2.0 },
+                                                       std::vector<std::string>{ "c" }),
+                true)
+{
+  return true;
+}
+template <typename Client>
+constexpr bool accepts_numbers_as_qdot(long)
+{
+  return false;
+}
 
 Vector6d hiddenPose()
 {
@@ -184,6 +214,10 @@ TEST(CppClient, BatchedCallsTakeOneEigenVectorPerConfiguration)
   const auto braced_now = client.frameJacobians("knot", flat, flat_qdot, { "knot" }, World, true);
   const auto empty_qdot = client.frameJacobians("knot", flat, {}, { "knot" }, World);  // {} is qdot: the current order
   const auto two_now = client.frameJacobians("knot", flat, {}, { "knot", "knot" });
+  // Two names where qdot goes, then frames, fit neither order: they must not compile.
+  static_assert(!accepts_names_as_qdot<RigidBodyClient>(0), "names as qdot, then frames, compile");
+  static_assert(!accepts_names_as_qdot<diff_rigid_body_ros::RigidBodyPool>(0), "names as qdot compile (pool)");
+  static_assert(accepts_numbers_as_qdot<RigidBodyClient>(0), "braced numbers as qdot must still compile");
   ASSERT_EQ(two_now.frames.size(), 2u);
   ASSERT_EQ(earlier_two.frames, two_now.frames);
   ASSERT_EQ(earlier_mixed.frames, two_now.frames);
