@@ -24,30 +24,18 @@ constexpr double MATRIX_TOLERANCE = 1e-12;   // relative, of the largest entry
 constexpr double FD_TOLERANCE = 1e-7;        // m per unit of q (central differences, h = 1e-6)
 constexpr double FIT_TOLERANCE = 1e-8;       // rad and m
 
-// Whether `frameJacobians(body, q, {a, b}, {"c"})` compiles for Client, with {a, b} two names or two numbers.
-template <typename Client>
-constexpr auto accepts_names_as_qdot(int)
-    -> decltype(std::declval<Client&>().frameJacobians(std::string(), std::vector<double>(), { "a", "b" },
+// Whether `frameJacobians(body, q, {a, b}, {"c"})` compiles for Client, with a and b of type Element
+// (two names, or two numbers: qdot).
+template <typename Client, typename Element>
+constexpr auto acceptsBracedQdot(int)
+    -> decltype(std::declval<Client&>().frameJacobians(std::string(), std::vector<double>(), { Element(), Element() },
                                                        std::vector<std::string>{ "c" }),
                 true)
 {
   return true;
 }
-template <typename Client>
-constexpr bool accepts_names_as_qdot(long)
-{
-  return false;
-}
-template <typename Client>
-constexpr auto accepts_numbers_as_qdot(int)
-    -> decltype(std::declval<Client&>().frameJacobians(std::string(), std::vector<double>(), { 1.0, 2.0 },
-                                                       std::vector<std::string>{ "c" }),
-                true)
-{
-  return true;
-}
-template <typename Client>
-constexpr bool accepts_numbers_as_qdot(long)
+template <typename Client, typename Element>
+constexpr bool acceptsBracedQdot(long)
 {
   return false;
 }
@@ -215,9 +203,9 @@ TEST(CppClient, BatchedCallsTakeOneEigenVectorPerConfiguration)
   const auto empty_qdot = client.frameJacobians("knot", flat, {}, { "knot" }, World);  // {} is qdot: the current order
   const auto two_now = client.frameJacobians("knot", flat, {}, { "knot", "knot" });
   // Two names where qdot goes, then frames, fit neither order: they must not compile.
-  static_assert(!accepts_names_as_qdot<RigidBodyClient>(0), "names as qdot, then frames, compile");
-  static_assert(!accepts_names_as_qdot<diff_rigid_body_ros::RigidBodyPool>(0), "names as qdot compile (pool)");
-  static_assert(accepts_numbers_as_qdot<RigidBodyClient>(0), "braced numbers as qdot must still compile");
+  static_assert(!acceptsBracedQdot<RigidBodyClient, const char*>(0), "names as qdot, then frames, compile");
+  static_assert(!acceptsBracedQdot<diff_rigid_body_ros::RigidBodyPool, const char*>(0), "names as qdot compile (pool)");
+  static_assert(acceptsBracedQdot<RigidBodyClient, double>(0), "braced numbers as qdot must still compile");
   ASSERT_EQ(two_now.frames.size(), 2u);
   ASSERT_EQ(earlier_two.frames, two_now.frames);
   ASSERT_EQ(earlier_mixed.frames, two_now.frames);
