@@ -72,7 +72,8 @@ inline std::size_t dynamicsConfigurations(std::size_t D, std::size_t bodies,
                           std::to_string(configurations * D) + " values (q's " + std::to_string(configurations) +
                               " configuration(s) x " + std::to_string(D) + "), or empty for zeros",
                           values->size()));
-    requireFinite(values->data(), values->size(), field);
+    if (!values->empty())
+      requireFinite(values->data(), values->size(), field);
   }
   return configurations;
 }
@@ -155,12 +156,9 @@ void forEachBodySlot(const SceneQueries& queries, const RequestLayout& layout, c
     }
 }
 
-/// Refuses an answer with a value that is not finite, naming its field.
-inline void requireFiniteResults(std::initializer_list<std::pair<const char*, const std::vector<double>*>> results)
-{
-  for (const auto& [field, values] : results)
-    requireFinite(values->data(), values->size(), field);
-}
+/// Refuses an answer with a value that is not finite, naming its field and index
+/// (finite_values.cpp: one pass over all the fields when they are finite).
+void requireFiniteResults(std::initializer_list<std::pair<const char*, const std::vector<double>*>> results);
 
 inline const double* slice(DoubleView values, std::size_t offset)
 {

@@ -137,6 +137,14 @@ private:
   bool marked_ = false, every_segment_ = false;
 };
 
+/// This thread's FrameScratch. In a shared library each use of a thread_local's
+/// name may look it up again (__tls_get_addr); callers bind the reference once.
+[[gnu::noinline]] FrameScratch& threadFrameScratch()
+{
+  thread_local FrameScratch scratch;
+  return scratch;
+}
+
 FrameReference frameReference(std::uint32_t reference)
 {
   if (reference > 2)
@@ -166,7 +174,7 @@ void SceneQueries::frameJacobians(const SceneState& current, const std::string& 
                                   DoubleView qdot, std::uint32_t reference, bool acceleration_bias,
                                   FrameJacobianAnswer& answer) const
 {
-  thread_local FrameScratch scratch;
+  FrameScratch& scratch = threadFrameScratch();
   scratch.lookUp(id_, body_name, frames, [&](std::vector<FrameSlot>& slots) {
     const std::size_t found = bodyIndex(body_name, "body");
     frameSlots(scene_, found, frames, link_index_, slots);

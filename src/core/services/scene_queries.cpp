@@ -6,9 +6,6 @@
 #include <limits>
 #include <sstream>
 #include <type_traits>
-#ifdef __SSE2__
-#include <emmintrin.h>
-#endif
 
 #include "diff_rigid_body/exceptions.h"
 #include "diff_rigid_body/algorithm/kinematics.h"
@@ -35,56 +32,22 @@ std::uint64_t nextQueriesId()
   return next++;
 }
 
-/// Whether every value is finite, value by value.
-bool eachFinite(const double* values, std::size_t count)
+/// One cache per thread, holding the workspaces of the last SceneQueries it
+/// served: a node's spinner threads each keep theirs for good.
+struct WorkspaceCache
 {
-  for (std::size_t i = 0; i < count; ++i)
-    if (!std::isfinite(values[i]))
-      return false;
-  return true;
-}
+  std::uint64_t owner = 0;
+  std::vector<std::unique_ptr<BodyWorkspace<double>>> bodies;
+};
 
-/// Whether every value is finite. An infinity or a NaN makes any sum it
-/// enters infinite or NaN, so a finite sum proves every value finite: one
-/// add per pair of values (SSE2, every x86-64; two chains). A sum that
-/// overflows from finite values alone is settled value by value.
-bool allFinite(const double* values, std::size_t count)
+/// This thread's cache, by one thread-local lookup (in a shared library each use
+/// of a thread_local's name may call __tls_get_addr again).
+[[gnu::noinline]] WorkspaceCache& threadWorkspaceCache()
 {
-  std::size_t i = 0;
-  double sum = 0.0;
-#ifdef __SSE2__
-  __m128d sum_a = _mm_setzero_pd(), sum_b = _mm_setzero_pd();
-  for (; i + 4 <= count; i += 4)
-  {
-    sum_a = _mm_add_pd(sum_a, _mm_loadu_pd(values + i));
-    sum_b = _mm_add_pd(sum_b, _mm_loadu_pd(values + i + 2));
-  }
-  double lanes[2];
-  _mm_storeu_pd(lanes, _mm_add_pd(sum_a, sum_b));
-  sum = lanes[0] + lanes[1];
-#endif
-  for (; i < count; ++i)
-    sum += values[i];
-  return std::isfinite(sum) || eachFinite(values, count);
-}
-
-/// Refuses the first value of `values` that is not finite, by `field` and index.
-[[noreturn]] void rejectNonFinite(const double* values, std::size_t count, const char* field)
-{
-  std::size_t i = 0;
-  while (i + 1 < count && std::isfinite(values[i]))
-    ++i;
-  std::ostringstream why;
-  why << field << "[" << i << "]: not finite (" << values[i] << ")";
-  reject(why.str());
+  thread_local WorkspaceCache cache;
+  return cache;
 }
 }  // namespace
-
-void requireFinite(const double* values, std::size_t count, const char* field)
-{
-  if (!allFinite(values, count))
-    rejectNonFinite(values, count, field);
-}
 
 SceneQueries::SceneQueries(Scene scene, const Eigen::Vector3d& gravity)
   : scene_(std::move(scene)), gravity_(gravity), id_(nextQueriesId())
@@ -114,14 +77,7 @@ SceneQueries::SceneQueries(Scene scene, const Eigen::Vector3d& gravity)
 
 BodyWorkspace<double>& SceneQueries::workspace(std::size_t index) const
 {
-  // One cache per thread, holding the workspaces of the last SceneQueries
-  // it served: a node's spinner threads each keep theirs for good.
-  struct Cache
-  {
-    std::uint64_t owner = 0;
-    std::vector<std::unique_ptr<BodyWorkspace<double>>> bodies;
-  };
-  thread_local Cache cache;
+  WorkspaceCache& cache = threadWorkspaceCache();
   if (cache.owner != id_)
   {
     cache.owner = id_;
