@@ -2,59 +2,58 @@
 // every answer pass through, at memory speed (one add per 2 values with SSE2,
 // per 4 with AVX where the CPU has it; chosen once at load time).
 #include <cmath>
+#include <cstring>
 #include <sstream>
 
 #include "diff_rigid_body/services/scene_queries.h"
 #include "services/finite_values.h"
 #include "services/request_checks.h"
 #include "services/request_layout.h"
-#ifdef DRB_FINITE_VALUES_X86
-#include <immintrin.h>
-#endif
 
 namespace diff_rigid_body
 {
 #ifdef DRB_FINITE_VALUES_X86
 namespace detail
 {
-__attribute__((target("avx"))) double sumAvx(const double* values, std::size_t count)
+namespace
 {
-  __m256d a = _mm256_setzero_pd(), b = a, c = a, d = a;
+/// The sum of `values` in four chains of Vector (GCC vector extensions, of
+/// Vector's lanes), 4 x lanes values per step, then the rest one by one.
+/// Inlined into each caller, whose target (SSE2, AVX) sets the instructions.
+template <typename Vector>
+[[gnu::always_inline]] inline double sumInChains(const double* values, std::size_t count)
+{
+  constexpr std::size_t lanes = sizeof(Vector) / sizeof(double);
+  Vector chains[4] = {};
   std::size_t i = 0;
-  for (; i + 16 <= count; i += 16)
-  {
-    a = _mm256_add_pd(a, _mm256_loadu_pd(values + i));
-    b = _mm256_add_pd(b, _mm256_loadu_pd(values + i + 4));
-    c = _mm256_add_pd(c, _mm256_loadu_pd(values + i + 8));
-    d = _mm256_add_pd(d, _mm256_loadu_pd(values + i + 12));
-  }
-  for (; i + 4 <= count; i += 4)
-    a = _mm256_add_pd(a, _mm256_loadu_pd(values + i));
-  double lanes[4];
-  _mm256_storeu_pd(lanes, _mm256_add_pd(_mm256_add_pd(a, b), _mm256_add_pd(c, d)));
-  double sum = (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
+  for (; i + 4 * lanes <= count; i += 4 * lanes)
+    for (std::size_t c = 0; c < 4; ++c)
+    {
+      Vector next;
+      std::memcpy(&next, values + i + c * lanes, sizeof(Vector));  // an unaligned load
+      chains[c] += next;
+    }
+  const Vector total = (chains[0] + chains[1]) + (chains[2] + chains[3]);
+  double sum = 0.0;
+  for (std::size_t l = 0; l < lanes; ++l)
+    sum += total[l];
   for (; i < count; ++i)
     sum += values[i];
   return sum;
 }
 
+typedef double Lanes2 __attribute__((vector_size(16)));
+typedef double Lanes4 __attribute__((vector_size(32)));
+}  // namespace
+
 double sumSse2(const double* values, std::size_t count)
 {
-  __m128d a = _mm_setzero_pd(), b = a, c = a, d = a;
-  std::size_t i = 0;
-  for (; i + 8 <= count; i += 8)
-  {
-    a = _mm_add_pd(a, _mm_loadu_pd(values + i));
-    b = _mm_add_pd(b, _mm_loadu_pd(values + i + 2));
-    c = _mm_add_pd(c, _mm_loadu_pd(values + i + 4));
-    d = _mm_add_pd(d, _mm_loadu_pd(values + i + 6));
-  }
-  double lanes[2];
-  _mm_storeu_pd(lanes, _mm_add_pd(_mm_add_pd(a, b), _mm_add_pd(c, d)));
-  double sum = lanes[0] + lanes[1];
-  for (; i < count; ++i)
-    sum += values[i];
-  return sum;
+  return sumInChains<Lanes2>(values, count);
+}
+
+__attribute__((target("avx"))) double sumAvx(const double* values, std::size_t count)
+{
+  return sumInChains<Lanes4>(values, count);
 }
 
 bool cpuHasAvx()

@@ -12,9 +12,9 @@ namespace diff_rigid_body
 {
 namespace detail
 {
-/// The sum of `values` in four 2-lane chains (8 values per step; SSE2 is in every x86-64).
+/// The sum of `values` in four 2-lane chains (SSE2, in every x86-64).
 double sumSse2(const double* values, std::size_t count);
-/// The sum of `values` in four 4-lane chains (16 values per step); only where cpuHasAvx().
+/// The sum of `values` in four 4-lane chains (AVX); only where cpuHasAvx().
 double sumAvx(const double* values, std::size_t count);
 /// Whether this CPU and its OS run AVX: requireFinite then uses sumAvx.
 bool cpuHasAvx();
