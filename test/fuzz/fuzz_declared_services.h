@@ -2,8 +2,9 @@
 // declaration), as fuzz_scene_queries.cpp's last request kind: a declared
 // service picked by index, each request field fuzzed by its type (names:
 // known, unknown, empty, random; float64[]: K x D values of the listed bodies
-// (all when none, K = 0 to 3, sometimes one more) or a random size and any
-// doubles; uint32[]: vertex indices; flags; uint8: any value), the member
+// (all when none, K = 0 to 3, sometimes one more), after a vertex list also
+// K x 3 values per selected vertex, or a random size and any doubles;
+// uint32[]: vertex indices; flags; uint8: any value), the member
 // called as the node's handler calls it. A service added with a declaration
 // is fuzzed without a line here.
 //
@@ -22,12 +23,24 @@
 
 namespace drb_fuzz
 {
-/// What a request's fuzzed fields have chosen so far: the bodies that size its arrays.
+/// What a request's fuzzed fields have chosen so far: the bodies that size its arrays, and
+/// the vertices a vertex list selects (its length; all of one listed body's when empty).
 struct FuzzedRequest
 {
   std::vector<std::string> bodies;
   std::size_t K = 1;
+  bool lists_vertices = false;
+  std::size_t vertices = 0;
 };
+
+/// How many vertices `listed` selects on the request's one body (0 for none or an unknown one).
+inline std::size_t selectedVertices(const FuzzedRequest& request, const std::vector<std::uint32_t>& listed)
+{
+  if (!listed.empty())
+    return listed.size();
+  const int index = request.bodies.size() == 1 ? findBody(queries().scene(), request.bodies[0]) : -1;
+  return index < 0 ? 0 : queries().scene().bodies[static_cast<std::size_t>(index)].vertexCount();
+}
 
 inline void fuzzField(FuzzedDataProvider& in, FuzzedRequest& request, std::string& body)
 {
@@ -40,13 +53,18 @@ inline void fuzzField(FuzzedDataProvider& in, FuzzedRequest& request, std::vecto
   if (request.bodies.empty())  // a body list; a later list (frames) keeps the body's size
     request.bodies = names;
 }
+/// K configurations of the bodies' coordinates or, after a vertex list, as often of 3
+/// values per selected vertex (dL/dp); the input picks.
 inline void fuzzField(FuzzedDataProvider& in, FuzzedRequest& request, std::vector<double>& values)
 {
-  values = fuzzedConfigurations(in, coordinatesOf(request.bodies), request.K);
+  const bool per_vertex = request.lists_vertices && in.ConsumeBool();
+  values = fuzzedConfigurations(in, per_vertex ? 3 * request.vertices : coordinatesOf(request.bodies), request.K);
 }
-inline void fuzzField(FuzzedDataProvider& in, FuzzedRequest&, std::vector<std::uint32_t>& vertices)
+inline void fuzzField(FuzzedDataProvider& in, FuzzedRequest& request, std::vector<std::uint32_t>& vertices)
 {
   vertices = fuzzedVertices(in);
+  request.lists_vertices = true;
+  request.vertices = selectedVertices(request, vertices);
 }
 inline void fuzzField(FuzzedDataProvider& in, FuzzedRequest&, bool& flag)
 {
