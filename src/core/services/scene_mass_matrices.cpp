@@ -75,8 +75,8 @@ void SceneQueries::massMatrices(const SceneState& current, const std::vector<std
       }
   // Finite inputs can still overflow (e.g. an inertia near DBL_MAX): never
   // return a non-finite number silently.
-  requireFinite(result.mass_matrices.data(), result.mass_matrices.size(), "result mass_matrices");
-  requireFinite(result.derivatives.data(), result.derivatives.size(), "result derivatives");
+  detail::requireFiniteResults(
+      { { "result mass_matrices", &result.mass_matrices }, { "result derivatives", &result.derivatives } });
   answer = std::move(result);
 }
 
