@@ -18,6 +18,8 @@ import rosgraph
 import rospkg
 import rospy
 
+from diff_rigid_body import service_fields, srv
+
 PKG = 'diff_rigid_body'
 SCENE = os.path.join(rospkg.RosPack().get_path(PKG), 'test', 'urdf', 'reliability_scene.urdf')
 DOC = os.path.join(rospkg.RosPack().get_path(PKG), 'docs', 'robustness.md')
@@ -56,17 +58,22 @@ class Node:
         return rospy.ServiceProxy(self.name(name), kind)
 
     def wait(self, timeout=60.0):
-        """Waits until it serves; returns False if it exited instead."""
+        """Waits until it serves every declared service (it advertises them one by one); returns
+        False if it exited instead."""
         deadline = time.time() + timeout
+        waiting = sorted(name for name, (_, declaration) in service_fields.declared_services(srv).items()
+                         if not declaration.benchmark_only)
         while time.time() < deadline:
             if self.process.poll() is not None:
                 return False
             try:
-                rospy.wait_for_service(self.name('get_state'), timeout=0.5)
-                return True
+                rospy.wait_for_service(self.name(waiting[0]), timeout=0.5)
+                waiting.pop(0)
+                if not waiting:
+                    return True
             except rospy.ROSException:
                 pass
-        raise AssertionError('the node neither served nor exited within %g s' % timeout)
+        raise AssertionError('the node neither served %s nor exited within %g s' % (', '.join(waiting), timeout))
 
     def exit_code(self, timeout=30.0):
         """Waits for the node to exit by itself; None if it is still running."""

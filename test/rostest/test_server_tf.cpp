@@ -76,7 +76,18 @@ class Tf : public RestoresState
 protected:
   Tf() : buffer_(ros::Duration(30.0)), listener_(buffer_) {}
 
-  /// The stamp of the first /tf publication of `frame` strictly after `after`.
+  /// Whether the buffer holds every fixture link's frame at `stamp`.
+  bool everyLinkAt(const ros::Time& stamp)
+  {
+    for (const FixtureBody& body : fixture().bodies)
+      for (const FixtureLink& link : body.links)
+        if (!buffer_.canTransform(fixture().fixed_frame, link.name, stamp))
+          return false;
+    return true;
+  }
+
+  /// The stamp of the first /tf publication of `frame` strictly after `after`, once every
+  /// fixture link's frame at that stamp has arrived.
   ros::Time waitForStampAfter(const std::string& frame, const ros::Time& after)
   {
     const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(kTimeout);
@@ -86,7 +97,8 @@ protected:
       {
         const geometry_msgs::TransformStamped latest =
             buffer_.lookupTransform(fixture().fixed_frame, frame, ros::Time(0));
-        if (latest.header.stamp > after)
+        // The listener's thread inserts a publication's frames one by one: wait for all of them.
+        if (latest.header.stamp > after && everyLinkAt(latest.header.stamp))
           return latest.header.stamp;
       }
       catch (const tf2::TransformException&)
