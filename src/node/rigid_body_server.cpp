@@ -8,7 +8,6 @@
 #include <geometry_msgs/TransformStamped.h>
 #include <tf2_msgs/TFMessage.h>
 
-#include "diff_rigid_body/services/bodies_answer.h"
 #include "diff_rigid_body/exceptions.h"
 #include "diff_rigid_body/state/state_file.h"
 
@@ -197,14 +196,6 @@ void RigidBodyServer::publishStaticLinks()
   static_broadcaster_.sendTransform(transforms);
 }
 
-bool RigidBodyServer::getBodies(GetBodies::Request&, GetBodies::Response& response)
-{
-  return serveAnswer<BodiesAnswer>(response, "get_bodies", [&](BodiesAnswer& answer) {
-    answer = describeBodies(queries_.scene());
-    answer.fixed_frame = frame_prefix_ + answer.fixed_frame;
-  });
-}
-
 bool RigidBodyServer::setState(SetState::Request& request, SetState::Response& response)
 {
   return serve(response, "set_state", [&] { applyStates(request.states); });
@@ -258,28 +249,20 @@ void RigidBodyServer::onTimer(const ros::TimerEvent&)
     ROS_ERROR_STREAM_THROTTLE(1.0, "rigid_body_server: " << failure);
 }
 
-// Reduced transport of get_vertex_jacobians; ~ping and ~echo (benchmark only) measure transport (bench/).
-bool RigidBodyServer::getVertexJacobiansCompact(GetVertexJacobiansCompact::Request& request,
-                                                GetVertexJacobiansCompact::Response& response)
-{
-  return serve(response, "get_vertex_jacobians_compact", [&] {
-    if (request.single_precision)
-      queries_.vertexRotationJacobians(*snapshot(), request.body, request.vertices, request.q, request.positions_only,
-                                       response.positions_f32, response.rotation_jacobians_f32);
-    else
-      queries_.vertexRotationJacobians(*snapshot(), request.body, request.vertices, request.q, request.positions_only,
-                                       response.positions, response.rotation_jacobians);
-  });
-}
-
 void RigidBodyServer::prepare(GetFrameJacobians::Request& request) const
 {
   node::removeFramePrefix(frame_prefix_, request.frames);  // "a/link" as tf names it, or "link"
 }
 
+void RigidBodyServer::present(BodiesAnswer& answer) const
+{
+  answer.fixed_frame = frame_prefix_ + answer.fixed_frame;
+}
+
 // The handlers of the services a core member answers (DRB_CORE_SERVICES, from each .srv's
 // declaration): the member gets a snapshot of the state and the request's fields in the .srv's
-// order, and fills the answer that serveAnswer moves into the response.
+// order (after prepare), and fills the answer that serveAnswer moves into the response (after
+// present).
 #define DRB_REQUEST_ARGUMENT(type, name) , request.name
 #define DRB_SERVE_CORE(Type, name, handler, member, Answer)                                                            \
   bool RigidBodyServer::handler(Type::Request& request, Type::Response& response)                                      \
@@ -287,12 +270,14 @@ void RigidBodyServer::prepare(GetFrameJacobians::Request& request) const
     return serveAnswer<Answer>(response, #name, [&](Answer& answer) {                                                  \
       prepare(request);                                                                                                \
       queries_.member(*snapshot() DRB_##Type##_REQUEST_FIELDS(DRB_REQUEST_ARGUMENT), answer);                          \
+      present(answer);                                                                                                 \
     });                                                                                                                \
   }
 DRB_CORE_SERVICES(DRB_SERVE_CORE)
 #undef DRB_SERVE_CORE
 #undef DRB_REQUEST_ARGUMENT
 
+// ~ping and ~echo (benchmark only) measure transport (bench/).
 bool RigidBodyServer::ping(Ping::Request&, Ping::Response& response)
 {
   return serve(response, "ping", [] {});

@@ -109,6 +109,13 @@ private:
   {
   }
   void prepare(GetFrameJacobians::Request& request) const;
+  /// What the node does to a core member's answer before it is sent: nothing, but get_bodies'
+  /// fixed_frame gets ~frame_prefix, as every frame id the node publishes.
+  template <typename Answer>
+  void present(Answer&) const
+  {
+  }
+  void present(BodiesAnswer& answer) const;
   void onSetStates(const BodyStateArray::ConstPtr& message);
   /// joint_states: named joints set, unknown names ignored (each logged
   /// once), a message with a non-finite position, a position count other

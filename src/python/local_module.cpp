@@ -2,6 +2,9 @@
 // "In process"). diff_rigid_body.local.LocalScene is its Python face; this module's Scene takes
 // each state-free service's request fields by name and returns its response fields as a dict.
 // A Refusal is raised as diff_rigid_body.client_types.DiffRigidBodyError(service, message).
+#include <string>
+#include <vector>
+
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
@@ -67,14 +70,10 @@ PYBIND11_MODULE(_local, m)
       .def(py::init(&load), "urdf"_a, "is_path"_a, "geometry"_a = "collision", "bodies"_a = std::vector<std::string>(),
            "density"_a = py::none(), "joints"_a = "model", "strict_inertia"_a = false, "floating_base"_a = false,
            "fixed_frame"_a = "", "gravity"_a = std::vector<double>{ 0.0, 0.0, -9.81 }, "find_package"_a = py::none())
-      .def_property_readonly("warnings", &LocalScene::warnings)
-      .def("get_bodies", &LocalScene::getBodies)
-      .def("get_vertex_jacobians_compact", &LocalScene::getVertexJacobiansCompact, "body"_a, "vertices"_a, "q"_a,
-           "positions_only"_a = false, "single_precision"_a = false);
+      .def_property_readonly("warnings", &LocalScene::warnings);
   diff_rigid_body::python::bindCoreServices(scene);
   // The services a Scene answers: the node's state-free ones.
-#define DRB_SERVICE_NAME(Type, name, handler, member, Answer) , #name
-  m.attr("SERVICES") =
-      py::make_tuple("get_bodies", "get_vertex_jacobians_compact" DRB_CORE_SERVICES(DRB_SERVICE_NAME));
+#define DRB_SERVICE_NAME(Type, name, handler, member, Answer) #name,
+  m.attr("SERVICES") = py::tuple(py::cast(std::vector<std::string>{ DRB_CORE_SERVICES(DRB_SERVICE_NAME) }));
 #undef DRB_SERVICE_NAME
 }

@@ -60,10 +60,6 @@ public:
   /// Unmodelled joints, then the load warnings (the node logs both).
   const std::vector<std::string>& warnings() const { return warnings_; }
 
-  py::dict getBodies() const;
-  py::dict getVertexJacobiansCompact(const std::string& body, const InputArray<std::uint32_t>& vertices,
-                                     const InputArray<double>& q, bool positions_only, bool single_precision) const;
-
   const SceneQueries& queries() const { return *queries_; }
   /// The URDF state: never read for a request with q (kept so that no query can meet an empty state).
   const SceneState& state() const { return state_; }

@@ -9,7 +9,6 @@
 
 #include <pybind11/stl.h>
 
-#include "diff_rigid_body/services/bodies_answer.h"
 #include "diff_rigid_body/exceptions.h"
 #include "local_scene.h"
 
@@ -119,41 +118,9 @@ py::object toPython(std::uint32_t value)
 }
 }  // namespace
 
-// One dict entry per field of an answer's field list (scene_queries.h, bodies_answer.h), under the
+// One dict entry per field of an answer's field list (scene_queries.h), under the
 // response field's name; used with `answer` and the dict `r` in scope.
 #define DRB_PYTHON_FIELD(type, name) r[#name] = toPython(std::move(answer.name));
-
-py::dict LocalScene::getBodies() const
-{
-  BodiesAnswer answer;
-  serve("get_bodies", [&] { answer = describeBodies(queries_->scene()); });
-  py::dict r;
-  DRB_GetBodies_RESPONSE_FIELDS(DRB_PYTHON_FIELD)
-  return r;
-}
-
-py::dict LocalScene::getVertexJacobiansCompact(const std::string& body, const InputArray<std::uint32_t>& vertices,
-                                               const InputArray<double>& q, bool positions_only,
-                                               bool single_precision) const
-{
-  const Values<double> x = requiredQ(q, "get_vertex_jacobians_compact");
-  const std::vector<std::uint32_t> selected = Values<std::uint32_t>(vertices).vector();
-  py::dict r;
-  // Out: float for the float32 transport's fields (*_f32), else double.
-  const auto answer = [&](auto out, const char* positions_field, const char* jacobians_field) {
-    std::vector<decltype(out)> positions, jacobians;
-    serve("get_vertex_jacobians_compact", [&] {
-      queries_->vertexRotationJacobians(state_, body, selected, x.view(), positions_only, positions, jacobians);
-    });
-    r[positions_field] = adopt(std::move(positions));
-    r[jacobians_field] = adopt(std::move(jacobians));
-  };
-  if (single_precision)
-    answer(0.0f, "positions_f32", "rotation_jacobians_f32");
-  else
-    answer(0.0, "positions", "rotation_jacobians");
-  return r;
-}
 
 // One method per row of DRB_CORE_SERVICES: the request fields as arguments (LocalField), the core
 // member on this scene's URDF state, the answer's fields as the dict.

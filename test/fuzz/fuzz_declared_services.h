@@ -9,7 +9,7 @@
 // is fuzzed without a line here.
 //
 // Invariant: a request either throws InvalidArgumentError, or answers with
-// only finite numbers in every float64[] response field.
+// only finite numbers in every float64[] and float32[] response field.
 #pragma once
 
 #include <cstdint>
@@ -80,6 +80,10 @@ void requireFiniteField(const T&, const char*)
 {
 }
 inline void requireFiniteField(const std::vector<double>& values, const char* field)
+{
+  requireAllFinite(values.data(), values.size(), field);
+}
+inline void requireFiniteField(const std::vector<float>& values, const char* field)
 {
   requireAllFinite(values.data(), values.size(), field);
 }

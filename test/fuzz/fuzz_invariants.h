@@ -25,7 +25,8 @@ inline void require(bool condition, const std::string& what)
     violated(what);
 }
 
-inline void requireAllFinite(const double* values, std::size_t count, const std::string& what)
+template <typename Real>
+void requireAllFinite(const Real* values, std::size_t count, const std::string& what)
 {
   for (std::size_t i = 0; i < count; ++i)
     if (!std::isfinite(values[i]))

@@ -141,6 +141,30 @@ struct BackpropAnswer
   DRB_ANSWER(DRB_Backprop_RESPONSE_FIELDS)
 };
 
+/// ~get_vertex_jacobians_compact: positions and rotation_jacobians as
+/// vertexRotationJacobians<double> writes them, or the *_f32 pair as
+/// vertexRotationJacobians<float> does (the other pair left empty).
+struct VertexJacobiansCompactAnswer
+{
+  DRB_ANSWER(DRB_GetVertexJacobiansCompact_RESPONSE_FIELDS)
+};
+
+/// ~get_bodies: per body (n of them), then per joint coordinate and per link,
+/// flattened in scene order, named as in srv/GetBodies.srv. Matrices are
+/// row-major; units [kg], [kg m^2], [m], [rad or m]. fixed_frame: without any
+/// frame prefix; names: each body's root link; masses: the total of its
+/// links; inertias (9 per body): the root link's group about its COM, root
+/// link axes; com_offsets (3 per body): that group's COM in the root link
+/// frame; dofs: d = len(x); joint_names: the joints of x, body after body,
+/// with joint_counts per body and their limits (+-inf where none);
+/// link_names: body after body in vertex order, with link_counts per body and
+/// per link its vertices, mass, inertia about its COM in link axes (9) and
+/// COM in its own frame (3).
+struct BodiesAnswer
+{
+  DRB_ANSWER(DRB_GetBodies_RESPONSE_FIELDS)
+};
+
 /// Standard gravity in the fixed frame, -9.81 m/s^2 along z (~gravity's default).
 inline Eigen::Vector3d standardGravity()
 {
@@ -239,6 +263,15 @@ public:
                                const std::vector<std::uint32_t>& vertices, DoubleView q,
                                bool positions_only, std::vector<Out>& positions,
                                std::vector<Out>& rotation_jacobians) const;
+
+  /// vertexRotationJacobians into the float32 fields of `answer` when
+  /// `single_precision`, else into its float64 fields (~get_vertex_jacobians_compact).
+  void vertexJacobiansCompact(const SceneState& current, const std::string& body,
+                              const std::vector<std::uint32_t>& vertices, DoubleView q, bool positions_only,
+                              bool single_precision, VertexJacobiansCompactAnswer& answer) const;
+
+  /// What each body of the scene is (BodiesAnswer), the same for every state (~get_bodies).
+  void bodies(const SceneState& current, BodiesAnswer& answer) const;
 
   /// dL/dx = sum_i J_i^T g_i at each of the K configurations of `q` (d K
   /// values; empty = the current state, K = 1), for gradients g given as

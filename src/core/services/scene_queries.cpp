@@ -212,4 +212,17 @@ template void SceneQueries::vertexRotationJacobians<float>(const SceneState&, co
                                                            DoubleView, bool, std::vector<float>&,
                                                            std::vector<float>&) const;
 
+void SceneQueries::vertexJacobiansCompact(const SceneState& current, const std::string& body,
+                                          const std::vector<std::uint32_t>& vertices, DoubleView q,
+                                          bool positions_only, bool single_precision,
+                                          VertexJacobiansCompactAnswer& answer) const
+{
+  if (single_precision)
+    vertexRotationJacobians(current, body, vertices, q, positions_only, answer.positions_f32,
+                            answer.rotation_jacobians_f32);
+  else
+    vertexRotationJacobians(current, body, vertices, q, positions_only, answer.positions,
+                            answer.rotation_jacobians);
+}
+
 }  // namespace diff_rigid_body

@@ -1,4 +1,6 @@
-#include "diff_rigid_body/services/bodies_answer.h"
+// SceneQueries::bodies (~get_bodies): what each body of the scene is, flattened
+// body after body as srv/GetBodies.srv lays it out.
+#include "diff_rigid_body/services/scene_queries.h"
 
 namespace diff_rigid_body
 {
@@ -27,11 +29,11 @@ void appendLinks(const BodyModel& body, BodiesAnswer& answer)
 }
 }  // namespace
 
-BodiesAnswer describeBodies(const Scene& scene)
+void SceneQueries::bodies(const SceneState&, BodiesAnswer& answer) const
 {
-  BodiesAnswer answer;
-  answer.fixed_frame = scene.fixed_frame;
-  for (const BodyModel& body : scene.bodies)
+  answer = BodiesAnswer();
+  answer.fixed_frame = scene_.fixed_frame;
+  for (const BodyModel& body : scene_.bodies)
   {
     const Segment& root = body.segments.front();
     answer.names.push_back(body.name);
@@ -46,7 +48,6 @@ BodiesAnswer describeBodies(const Scene& scene)
     answer.joint_upper.insert(answer.joint_upper.end(), body.joint_upper.begin(), body.joint_upper.end());
     appendLinks(body, answer);
   }
-  return answer;
 }
 
 }  // namespace diff_rigid_body
