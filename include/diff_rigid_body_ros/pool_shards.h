@@ -25,18 +25,6 @@ namespace diff_rigid_body_ros
 {
 namespace pool
 {
-/// The registry's name (services.h) of each srv type.
-template <typename Service>
-struct ServiceName;
-#define DRB_POOL_SERVICE_NAME(name, type, ...)                                                                         \
-  template <>                                                                                                          \
-  struct ServiceName<diff_rigid_body::type>                                                                            \
-  {                                                                                                                    \
-    static constexpr const char* value = #name;                                                                        \
-  };
-DIFF_RIGID_BODY_SERVICES(DRB_POOL_SERVICE_NAME)
-#undef DRB_POOL_SERVICE_NAME
-
 /// Per sharded service: its name, the request fields that hold K runs (an empty field, e.g. qdot =
 /// zeros, stays empty in every shard) and the response fields that do, as member pointers: the
 /// fields whose comment in the .srv begins with "[per configuration]" (DRB_SHARDED_SERVICES).

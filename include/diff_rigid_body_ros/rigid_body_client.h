@@ -41,6 +41,7 @@
 
 #include "diff_rigid_body_ros/client_arrays.h"
 #include "diff_rigid_body_ros/client_batches.h"
+#include "diff_rigid_body_ros/client_declared.h"
 #include "diff_rigid_body_ros/client_frames.h"
 #include "diff_rigid_body_ros/client_names.h"
 #include "diff_rigid_body_ros/client_requests.h"
@@ -48,7 +49,7 @@
 
 namespace diff_rigid_body_ros
 {
-class RigidBodyClient : public EigenBatches<RigidBodyClient>
+class RigidBodyClient : public EigenBatches<RigidBodyClient>, public DeclaredQueries<RigidBodyClient>
 {
 public:
   /// \param server   the node's name, resolved in nh's namespace (default "rigid_body_server").
@@ -277,6 +278,12 @@ public:
     }
     if (!srv.response.success)
       throw ServiceError(server_ + "/" + service, srv.response.message);
+  }
+  /// call(name, srv) with the service's registry name (services.h).
+  template <typename Service>
+  void call(Service& srv)
+  {
+    call(ServiceName<Service>::value, srv);
   }
 
 private:

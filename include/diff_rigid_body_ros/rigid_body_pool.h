@@ -2,7 +2,8 @@
 // counterpart of diff_rigid_body.RigidBodyPool (src/diff_rigid_body/pool.py).
 //
 // A call of K > 1 configurations to massMatrices, inverseDynamics, forwardDynamics,
-// vertexJacobians or backprop (or call() with any service of pool_shards.h) is cut into contiguous
+// vertexJacobians, backprop, frameJacobians, centerOfMass (or to query<Srv>, a generated method of
+// client_declared.h, or call() with any service of pool_shards.h) is cut into contiguous
 // shards, one per live instance, sent concurrently (one worker thread per instance) and joined in
 // configuration order: the answer has the bits of one instance's answer.
 //  - Same scene: the constructor asks every instance for get_bodies and throws PoolError for an
@@ -34,6 +35,7 @@
 #include <ros/ros.h>
 
 #include "diff_rigid_body_ros/client_batches.h"
+#include "diff_rigid_body_ros/client_declared.h"
 #include "diff_rigid_body_ros/client_frames.h"
 #include "diff_rigid_body_ros/client_requests.h"
 #include "diff_rigid_body_ros/client_responses.h"
@@ -43,7 +45,7 @@
 
 namespace diff_rigid_body_ros
 {
-class RigidBodyPool : public EigenBatches<RigidBodyPool>
+class RigidBodyPool : public EigenBatches<RigidBodyPool>, public DeclaredQueries<RigidBodyPool>
 {
 public:
   /// `namespaces`: the instances, each a namespace, e.g. {"/pool1", "/pool2"} (node

@@ -21,3 +21,18 @@
 
 // Every srv type's header and DIFF_RIGID_BODY_SERVICES, generated from srv/*.srv.
 #include "diff_rigid_body/services/service_messages.h"
+
+namespace diff_rigid_body_ros
+{
+/// ServiceName<diff_rigid_body::Type>::value: the registry's name of each srv type (~value).
+template <typename Service>
+struct ServiceName;
+#define DRB_SERVICE_NAME(name, type, ...)                                                                              \
+  template <>                                                                                                          \
+  struct ServiceName<diff_rigid_body::type>                                                                            \
+  {                                                                                                                    \
+    static constexpr const char* value = #name;                                                                        \
+  };
+DIFF_RIGID_BODY_SERVICES(DRB_SERVICE_NAME)
+#undef DRB_SERVICE_NAME
+}  // namespace diff_rigid_body_ros

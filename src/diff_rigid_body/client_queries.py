@@ -8,9 +8,11 @@ methods lay out the requests and shape the answers (shapes: the module docstring
 """
 import numpy as np
 
+from diff_rigid_body import srv
 from diff_rigid_body.client_arguments import earlier_order, numbers_before_names
 from diff_rigid_body.client_arrays import (AnswerShape, floats, indices, optional_values, vertex_blocks,
                                           vertex_configurations)
+from diff_rigid_body.client_declared import add_declared_methods, declared_core_services
 from diff_rigid_body.client_frames import FrameQueries
 from diff_rigid_body.client_names import body_names
 from diff_rigid_body.client_types import (ForwardDynamicsResult, InverseDynamicsResult, MassMatrices,
@@ -156,3 +158,8 @@ class SceneQueries(FrameQueries):
                       q=optional_values(q))
         gradient = np.asarray(r.gradient)
         return gradient.reshape(-1) if K is None else gradient.reshape(K, -1)
+
+
+# query(service, ...) for every state-free service, and the method of each one this class does not
+# define (client_declared).
+add_declared_methods(SceneQueries, declared_core_services(srv))

@@ -30,8 +30,8 @@ Standard library only: the build runs this module before the package exists.
 import collections
 import re
 
-__all__ = ['Declaration', 'Field', 'PER_CONFIGURATION', 'declared_services', 'parse_declaration', 'parse_fields',
-           'parse_service', 'per_configuration']
+__all__ = ['Declaration', 'Field', 'PER_CONFIGURATION', 'client_order', 'declared_services', 'parse_declaration',
+           'parse_fields', 'parse_service', 'per_configuration']
 
 #: The marker that opens a per-configuration field's comment.
 PER_CONFIGURATION = '[per configuration]'
@@ -101,3 +101,20 @@ def parse_service(text):
 def per_configuration(fields):
     """The names of the per-configuration fields, in order."""
     return tuple(field.name for field in fields if field.per_configuration)
+
+
+#: The request fields that name the body or bodies of a query.
+BODY_FIELDS = ('body', 'bodies')
+
+
+def client_order(request):
+    """A request's fields in the order the client methods take them (docs/interface.md, "Client
+    argument order"): the body or bodies, then q, then the other per-configuration fields, then the
+    rest (the selection and the options), each group in the .srv's order."""
+    def group(field):
+        if field.name in BODY_FIELDS:
+            return 0
+        if field.name == 'q':
+            return 1
+        return 2 if field.per_configuration else 3
+    return sorted(request, key=group)

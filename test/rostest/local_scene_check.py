@@ -112,6 +112,16 @@ class LocalSceneAgainstNode(unittest.TestCase):
                     assert_same(self, getattr(local, method)(body, **args), getattr(node, method)(body, **args),
                                 '%s.%s(%s)' % (name, method, body))
 
+    def test_c_generated_queries(self):
+        """query(service, ...) (client_declared) answers in process as through the node, bit for bit."""
+        for name, (local, node, bodies) in self.pairs.items():
+            body = bodies.names[0]
+            q = self.configurations(bodies, [body])
+            for service, args in (('get_mass_matrix', (body, q, True)),
+                                  ('get_vertex_jacobians_compact', (body, q, [0, 1])),
+                                  ('get_frame_jacobians', (body, q, q[::-1], None, 'local', True))):
+                assert_same(self, local.query(service, *args), node.query(service, *args), '%s %s' % (name, service))
+
     def assert_same_refusal(self, local, node, method, *args, **kwargs):
         with self.assertRaises(DiffRigidBodyError) as node_refusal:
             getattr(node, method)(*args, **kwargs)

@@ -145,6 +145,52 @@ TEST(RigidBodyPool, AnswersEqualOneInstanceBitForBit)
   EXPECT_TRUE(log.empty()) << log.front();
 }
 
+// The generated methods (client_declared.h), arguments in the client order: query<Srv> on a client
+// gives the response that the hand-written method splits (its values, in the .srv's layout), and
+// the pool's generated vertexJacobiansCompact (the pool writes no compact method) answers K
+// configurations, sharded, with the bits of one instance.
+TEST(RigidBodyPool, GeneratedMethodsAnswerAsTheHandWrittenOnes)
+{
+  std::vector<std::string> log;
+  drb::RigidBodyPool pool(kPool, quietOptions(&log));
+  drb::RigidBodyClient one(ros::NodeHandle(), "/pool1/rigid_body_server", ros::Duration(60.0));
+  const auto qs = configurations(7);
+  const auto M = one.massMatrices({}, flat(qs));
+  const diff_rigid_body::GetMassMatrix::Response raw = one.query<diff_rigid_body::GetMassMatrix>(
+      std::vector<std::string>{}, flat(qs));
+  ASSERT_EQ(raw.mass_matrices.size(), 7u * 64u);
+  for (std::size_t k = 0; k < 7; ++k)
+    for (Eigen::Index r = 0; r < 8; ++r)
+      for (Eigen::Index c = 0; c < 8; ++c)
+        EXPECT_EQ(raw.mass_matrices[64 * k + 8 * r + c], M.M[k](r, c)) << "M, configuration " << k;
+  EXPECT_TRUE(raw.derivatives.empty()) << "derivatives left out: false";
+
+  const auto frames = one.frameJacobians(kBody, flat(qs), {}, { "panda_hand" }, drb::FrameReference::Local);
+  const auto frames_raw = one.query<diff_rigid_body::GetFrameJacobians>(
+      kBody, flat(qs), std::vector<double>{}, std::vector<std::string>{ "panda_hand" },
+      static_cast<std::uint8_t>(drb::FrameReference::Local));
+  ASSERT_EQ(frames_raw.jacobians.size(), 7u * 6u * 8u);
+  for (std::size_t k = 0; k < 7; ++k)
+    for (Eigen::Index r = 0; r < 6; ++r)
+      for (Eigen::Index c = 0; c < 8; ++c)
+        EXPECT_EQ(frames_raw.jacobians[48 * k + 8 * r + c], frames.J[k](r, c)) << "J, configuration " << k;
+
+  const std::vector<std::uint32_t> vertices = { 0, 5, 1129 };
+  const auto compact = pool.vertexJacobiansCompact(kBody, flat(qs), vertices);
+  const auto compact1 = one.vertexJacobiansCompact(kBody, qs, vertices);
+  ASSERT_EQ(compact1.size(), 7u);
+  ASSERT_EQ(compact.positions.size(), 7u * 3u * 3u);
+  ASSERT_EQ(compact.rotation_jacobians.size(), 7u * 3u * 3u * 8u);
+  for (std::size_t k = 0; k < 7; ++k)
+  {
+    EXPECT_EQ(0, std::memcmp(compact.positions.data() + 9 * k, compact1[k].positions.data(), 9 * sizeof(double)))
+        << "pool positions, configuration " << k;
+    EXPECT_EQ(0, std::memcmp(compact.rotation_jacobians.data() + 72 * k, compact1[k].Jr.data(), 72 * sizeof(double)))
+        << "pool Jr, configuration " << k;
+  }
+  EXPECT_TRUE(log.empty()) << log.front();
+}
+
 TEST(RigidBodyPool, BatchedCallsTakeOneEigenVectorPerConfiguration)
 {
   // As RigidBodyClient: massMatrices, inverseDynamics, forwardDynamics with std::vector<VectorXd>
