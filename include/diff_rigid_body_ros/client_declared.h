@@ -11,8 +11,9 @@
 // A service whose declaration names a C++ method (DRB_CLIENT_METHODS) has that method here,
 // query<Srv> under its name: `energy(bodies, q)` for `C++: energy`. A hand-written method of the
 // same name in the client hides it (C++ name hiding) and keeps its richer result type, so only a
-// service without one answers with its Response. The pool's calls are sharded over its instances
-// (pool_shards.h) and joined.
+// service without one answers with its Response. The pool answers the K-configuration services
+// (pool_shards.h: sharded over its instances and joined); query<GetBodies> on a pool does not
+// compile (static_assert): its bodies() holds the scene it checked.
 #pragma once
 
 #include <utility>

@@ -15,6 +15,7 @@
 #include <numeric>
 #include <string>
 #include <tuple>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -43,6 +44,16 @@ struct Sharding;
   };
 DRB_SHARDED_SERVICES(DRB_POOL_SHARDING)
 #undef DRB_POOL_SHARDING
+
+/// True for a service the pool can shard (one with a Sharding<Service>): the K-configuration ones.
+template <typename Service, typename = void>
+struct IsSharded : std::false_type
+{
+};
+template <typename Service>
+struct IsSharded<Service, std::void_t<decltype(Sharding<Service>::service)>> : std::true_type
+{
+};
 
 /// The scene's d per body name, and its body order (an empty `bodies` field means all of them).
 struct SceneDofs

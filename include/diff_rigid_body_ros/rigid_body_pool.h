@@ -158,6 +158,9 @@ public:
   template <typename Service>
   void call(Service& srv)
   {
+    static_assert(pool::IsSharded<Service>::value,
+                  "RigidBodyPool answers the K-configuration services (DRB_SHARDED_SERVICES); "
+                  "get_bodies is bodies(), and a service without configurations goes to one RigidBodyClient");
     probeDownInstances();
     const std::size_t K = pool::configurationCount<Service>(srv.request, dofs_);
     std::deque<std::pair<std::size_t, std::size_t>> pending{ { 0, K } };  // K = 0: the whole request
