@@ -8,26 +8,29 @@ empty, a flag False, a number 0, as in an unset ROS request), and converted by t
 
 =============  =============================================================================
 ``string[]``   one name or a list of names (``client_names.body_names``)
-``string``     a name; None = ''
+``string``     a name (str, or bytes as UTF-8); None = ''
 ``float64[]``  any array-like, flattened; None = empty (for q: the node's current state)
 ``uint32[]``   indices (``vertices``: checked, ``client_arrays.indices``); None = empty
 ``bool``       anything truthy
-``uint8``      a number, or the name of one of the .srv's constants (``'world'`` for WORLD)
+``uint8``      a whole number 0..255, or the name of a .srv constant (``'world'`` for WORLD)
 =============  =============================================================================
 
 The answer is a named tuple, ``<SrvType>Answer``, with the response's fields but success and
 message: arrays as numpy, names as lists, numbers as they are. A per-configuration field
 (``[per configuration]`` in the .srv) is (K, values per configuration) when the request's q has
-two or more axes (K configurations, one per row), else flat.
+two or more axes (K configurations, one per row; K = 0 is refused, as an empty q would mean
+the node's current state), else flat.
 
 A service whose .srv declares a Python method that no hand-written method of
 :class:`~diff_rigid_body.client_queries.SceneQueries` defines gets that method: ``energy(...)`` is
 ``query('get_energy', ...)``. Both clients, both pools (sharded by the per-configuration fields)
 and :class:`~diff_rigid_body.local.LocalScene` have them. A hand-written method keeps its richer
-result type.
+result type. A pool shards the K-configuration services over its instances and sends the others
+(get_bodies) whole to one live instance; the C++ pool answers the K-configuration ones only.
 
 A refusal raises :class:`~diff_rigid_body.client_types.DiffRigidBodyError` as any call does; an
-argument that is not a request field raises TypeError naming it.
+argument that is not a request field raises TypeError naming it, and a value its field cannot take
+(a uint8 of 1.5 or 300, a q of no configurations) ValueError naming the service and the field.
 """
 import collections
 import inspect
@@ -79,6 +82,8 @@ class DeclaredService(object):
         if field.type == 'string[]':
             return body_names(value)
         if field.type == 'string':
+            if isinstance(value, bytes):
+                return value.decode('utf-8')
             return '' if value is None else str(value)
         if field.type == 'float64[]':
             return optional_values(value)
@@ -95,12 +100,13 @@ class DeclaredService(object):
             return 0
         if isinstance(value, str):
             if value.upper() not in self.constants:
-                raise ValueError('%s: one of %s, got %r'
-                                 % (field.name, ', '.join(sorted(n.lower() for n in self.constants)), value))
+                raise ValueError('%s: %s: one of %s, got %r'
+                                 % (self.name, field.name, ', '.join(sorted(n.lower() for n in self.constants)), value))
             return self.constants[value.upper()]
-        if not 0 <= int(value) <= 255:
-            raise ValueError('%s: %r is not a uint8 (0 to 255)' % (field.name, value))
-        return int(value)
+        number = float(value)
+        if not (number.is_integer() and 0 <= number <= 255):
+            raise ValueError('%s: %s: %r is not a uint8 (a whole number 0 to 255)' % (self.name, field.name, value))
+        return int(number)
 
     def answer(self, response, q):
         """The response as :attr:`answer_type`, per-configuration fields (K, -1) for a q of 2+ axes."""
@@ -110,7 +116,7 @@ class DeclaredService(object):
             value = getattr(response, field.name)
             if field.type.endswith('[]') and field.type != 'string[]':
                 value = np.asarray(value)
-                if batched and field.per_configuration and value.size:
+                if batched and field.per_configuration and value.size % np.shape(q)[0] == 0:
                     value = value.reshape(np.shape(q)[0], -1)
             elif field.type == 'string[]':
                 value = list(value)
@@ -120,6 +126,8 @@ class DeclaredService(object):
     def call(self, client, args, kwargs):
         """``client.call`` of this service with the arguments converted, its answer shaped."""
         fields, q = self.request_fields(args, kwargs)
+        if q is not None and np.ndim(q) >= 2 and np.shape(q)[0] == 0:  # empty would mean the current state
+            raise ValueError('%s: q: at least one configuration, got shape %s' % (self.name, np.shape(q)))
         return self.answer(client.call(self.name, **fields), q)
 
 
