@@ -9,10 +9,13 @@
 // is fuzzed without a line here.
 //
 // Invariant: a request either throws InvalidArgumentError, or answers with
-// only finite numbers in every float64[] and float32[] response field.
+// only finite numbers in every float64[] and float32[] response field (the
+// joint limits, joint_lower and joint_upper, may be infinite: "none"; never NaN).
 #pragma once
 
+#include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -75,13 +78,23 @@ inline void fuzzField(FuzzedDataProvider& in, FuzzedRequest&, std::uint8_t& valu
   value = in.ConsumeIntegral<std::uint8_t>();
 }
 
+/// The response fields whose numbers may be infinite: joint limits, +-inf where a joint has none.
+inline bool mayBeInfinite(const char* field)
+{
+  return std::strcmp(field, "joint_lower") == 0 || std::strcmp(field, "joint_upper") == 0;
+}
+
 template <typename T>
 void requireFiniteField(const T&, const char*)
 {
 }
 inline void requireFiniteField(const std::vector<double>& values, const char* field)
 {
-  requireAllFinite(values.data(), values.size(), field);
+  if (!mayBeInfinite(field))
+    return requireAllFinite(values.data(), values.size(), field);
+  for (std::size_t i = 0; i < values.size(); ++i)
+    if (std::isnan(values[i]))
+      violated(std::string(field) + "[" + std::to_string(i) + "] is NaN");
 }
 inline void requireFiniteField(const std::vector<float>& values, const char* field)
 {
