@@ -193,6 +193,44 @@ TEST(SceneQueries, CompactTransportIsTheFullAnswerReduced)
   EXPECT_TRUE(no_rotation.empty());
 }
 
+// ~get_vertex_jacobians_compact fills the precision it is asked for and leaves
+// the other pair of fields empty; its values are get_vertex_jacobians' (the
+// rotation columns of a free body's Jacobian), rounded to float32 when asked.
+TEST(SceneQueries, CompactServiceFillsTheAskedPrecisionOnly)
+{
+  const drb::SceneQueries queries = twoBodyScene();
+  const drb::SceneState current = queries.initialState();
+  const std::vector<std::uint32_t> vertices = { 5, 1 };
+  const std::vector<double> q = { -0.7, 1.2, 0.3, 0.5, -0.4, 2.0, 0.1, -0.2, 0.9, 0.0, 0.3, -1.0 };  // K = 2
+  std::vector<double> positions, jacobians;
+  queries.vertexJacobians(current, "cube", vertices, q, positions, jacobians);
+  ASSERT_EQ(positions.size(), 12u);
+  ASSERT_EQ(jacobians.size(), 72u);
+
+  drb::VertexJacobiansCompactAnswer full, single;
+  queries.vertexJacobiansCompact(current, "cube", vertices, q, false, false, full);
+  queries.vertexJacobiansCompact(current, "cube", vertices, q, false, true, single);
+  EXPECT_TRUE(full.positions_f32.empty());
+  EXPECT_TRUE(full.rotation_jacobians_f32.empty());
+  EXPECT_TRUE(single.positions.empty());
+  EXPECT_TRUE(single.rotation_jacobians.empty());
+  ASSERT_EQ(full.positions.size(), 12u);
+  ASSERT_EQ(full.rotation_jacobians.size(), 36u);
+  ASSERT_EQ(single.positions_f32.size(), 12u);
+  ASSERT_EQ(single.rotation_jacobians_f32.size(), 36u);
+  for (std::size_t i = 0; i < positions.size(); ++i)
+  {
+    EXPECT_EQ(full.positions[i], positions[i]);
+    EXPECT_EQ(single.positions_f32[i], static_cast<float>(positions[i]));
+  }
+  for (std::size_t row = 0; row < 12; ++row)  // K x N vertices x 3 rows, 3 rotation columns each
+    for (std::size_t c = 0; c < 3; ++c)
+    {
+      EXPECT_EQ(full.rotation_jacobians[3 * row + c], jacobians[6 * row + c]);
+      EXPECT_EQ(single.rotation_jacobians_f32[3 * row + c], static_cast<float>(jacobians[6 * row + c]));
+    }
+}
+
 // Results that would not fit the output type are refused (naming q and the
 // body) before anything is written, like get_vertex_jacobians: never inf.
 // FLT_MAX = 3.4028e38, DBL_MAX = 1.7977e308.
