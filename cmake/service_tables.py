@@ -17,12 +17,14 @@ From each .srv's declaration (diff_rigid_body.service_fields), in the order of t
     DRB_CLIENT_METHODS(X)           X(Type, C++ method) for the services of DRB_CORE_SERVICES with a
                                     C++ method (the clients' generated methods, client_declared.h)
 
-The header is ROS-free (macros only): the node advertises from the first (services.h), the core
-declares its answer structs with the second, the node, the in-process module and the fuzz target
-bind the core members and the C++ client builds their requests (client_requests.h) from the
-third and fourth, the C++ pool (pool_shards.h) shards with the
-fifth, and both C++ clients name their generated methods with the last (client_declared.h). It
-is rewritten only when its text changes.
+The header is ROS-free (macros only). Its readers: the node advertises from
+DIFF_RIGID_BODY_SERVICES (services.h); the core declares its answer structs with
+DRB_<Type>_RESPONSE_FIELDS (scene_queries.h); the node, the in-process module and the fuzz target
+bind the core members with DRB_CORE_SERVICES and DRB_<Type>_REQUEST_FIELDS; the C++ clients build
+their requests with DRB_<Type>_REQUEST_FIELDS and DRB_<Type>_CLIENT_FIELDS (client_requests.h);
+the C++ pool shards with DRB_SHARDED_SERVICES (pool_shards.h); and both C++ clients name their
+generated methods with DRB_CLIENT_METHODS (client_declared.h). It is rewritten only when its text
+changes.
 """
 import importlib.util
 import os

@@ -26,9 +26,9 @@ instances.
 Every service a core member answers (DRB_CORE_SERVICES, `core:` in its declaration) declares its
 answer struct in scene_queries.h from its own response fields, so that the node and the in-process
 module move exactly the response's fields, and its SceneQueries member takes the request's fields
-under their names and in the .srv's order (every binding passes them by position); the node
-answers the others itself, and the in-process
-module (_local.SERVICES) answers exactly the core services.
+under their names and in the .srv's order (every binding passes them by position). The node
+answers the other services itself; the in-process module (_local.SERVICES) answers exactly the
+core ones.
 GetBodies.srv and BodyState.msg comment every field in the user's terms, `rossrv show -r` prints the
 comments, and README.md names that command.
 """
