@@ -170,14 +170,18 @@ class PoolFailover(unittest.TestCase):
                 return answer
             return send
         for name, instance in instances.items():
-            instance.client.send = recording(name, 3.0 if name == 'pool3' else 0.0)
+            instance.client.send = recording(name, 9.0 if name == 'pool3' else 0.0)
         try:
             for _ in range(8):
                 self.pool.mass_matrix(q=configurations(600)[:, None, :], derivatives=True)
         finally:
             for name, instance in instances.items():
                 instance.client.send = originals[name]
-        self.assertLess(shards['pool3'][-1], 0.6 * min(shards['pool1'][-1], shards['pool2'][-1]), shards)
+        # pool3 is 10 times slower, so its share tends to 1/21 of the 600 (about 29 a call) and the
+        # others' to 10/21 (about 286). The last three calls summed, and a factor 2 to spare: on two
+        # cores shared by three nodes and the test, a fast instance's measured rate can halve.
+        last = dict((name, sum(sent[-3:])) for name, sent in shards.items())
+        self.assertLess(last['pool3'], 0.5 * min(last['pool1'], last['pool2']), shards)
 
     def test_7_instance_killed_mid_call_changes_nothing(self):
         pid = node_pid('/pool2/rigid_body_server')
