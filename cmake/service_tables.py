@@ -19,8 +19,10 @@ From each .srv's declaration (diff_rigid_body.service_fields), in the order of t
 
 The header is ROS-free (macros only). Its readers: the node advertises from
 DIFF_RIGID_BODY_SERVICES (services.h); the core declares its answer structs with
-DRB_<Type>_RESPONSE_FIELDS (scene_queries.h); the node, the in-process module and the fuzz target
-bind the core members with DRB_CORE_SERVICES and DRB_<Type>_REQUEST_FIELDS; the C++ clients build
+DRB_<Type>_RESPONSE_FIELDS (scene_queries.h), which the in-process module (local_scene_queries.cpp)
+and the fuzz target (fuzz_declared_services.h) also read to convert and check the answers; the
+node, the in-process module and the fuzz target bind the core members with DRB_CORE_SERVICES and
+DRB_<Type>_REQUEST_FIELDS; the C++ clients build
 their requests with DRB_<Type>_REQUEST_FIELDS and DRB_<Type>_CLIENT_FIELDS (client_requests.h);
 the C++ pool shards with DRB_SHARDED_SERVICES (pool_shards.h); and both C++ clients name their
 generated methods with DRB_CLIENT_METHODS (client_declared.h). It is rewritten only when its text

@@ -18,8 +18,8 @@ empty, a flag False, a number 0, as in an unset ROS request), and converted by t
 The answer is a named tuple, ``<SrvType>Answer``, with the response's fields but success and
 message: arrays as numpy, names as lists, numbers as they are. A per-configuration field
 (``[per configuration]`` in the .srv) is (K, values per configuration) when the request's q has
-two or more axes (K configurations, one per row; K = 0 is refused, as an empty q would mean
-the node's current state), else flat.
+two or more axes (K configurations, one per row; such a q holding no value is refused, as an
+empty q would mean the node's current state), else flat.
 
 A service whose .srv declares a Python method that no hand-written method of
 :class:`~diff_rigid_body.client_queries.SceneQueries` defines gets that method: ``energy(...)`` is
@@ -30,7 +30,7 @@ result type. A pool shards the K-configuration services over its instances and s
 
 A refusal raises :class:`~diff_rigid_body.client_types.DiffRigidBodyError` as any call does; an
 argument that is not a request field raises TypeError naming it, and a value its field cannot take
-(a uint8 of 1.5 or 300, a q of no configurations) ValueError naming the service and the field.
+(a uint8 of 1.5 or 300, a q of two or more axes holding no value) ValueError naming the service and the field.
 """
 import collections
 import inspect
@@ -98,12 +98,17 @@ class DeclaredService(object):
     def _number(self, field, value):
         if value is None:
             return 0
+        if isinstance(value, bytes):
+            value = value.decode('utf-8', 'replace')
         if isinstance(value, str):
             if value.upper() not in self.constants:
                 raise ValueError('%s: %s: one of %s, got %r'
                                  % (self.name, field.name, ', '.join(sorted(n.lower() for n in self.constants)), value))
             return self.constants[value.upper()]
-        number = float(value)
+        try:
+            number = float(value)
+        except (TypeError, ValueError, OverflowError):
+            number = float('nan')  # refused below, naming the service and the field
         if not (number.is_integer() and 0 <= number <= 255):
             raise ValueError('%s: %s: %r is not a uint8 (a whole number 0 to 255)' % (self.name, field.name, value))
         return int(number)
@@ -126,8 +131,9 @@ class DeclaredService(object):
     def call(self, client, args, kwargs):
         """``client.call`` of this service with the arguments converted, its answer shaped."""
         fields, q = self.request_fields(args, kwargs)
-        if q is not None and np.ndim(q) >= 2 and np.shape(q)[0] == 0:  # empty would mean the current state
-            raise ValueError('%s: q: at least one configuration, got shape %s' % (self.name, np.shape(q)))
+        if q is not None and np.ndim(q) >= 2 and np.size(q) == 0:  # empty would mean the current state
+            raise ValueError('%s: q: at least one configuration of at least one value, got shape %s'
+                             % (self.name, np.shape(q)))
         return self.answer(client.call(self.name, **fields), q)
 
 

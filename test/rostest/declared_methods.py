@@ -149,8 +149,11 @@ class DeclaredMethods(unittest.TestCase):
             c.query('get_frame_jacobians', self.body, reference='up')
         with self.assertRaisesRegex(ValueError, r'get_frame_jacobians: reference: 1.5 is not a uint8'):
             c.query('get_frame_jacobians', self.body, self.q[0], reference=1.5)
-        with self.assertRaisesRegex(ValueError, r'get_mass_matrix: q: at least one configuration'):
-            c.query('get_mass_matrix', self.body, np.zeros((0, len(self.q[0]))))
+        with self.assertRaisesRegex(ValueError, r'get_frame_jacobians: reference: \[1\] is not a uint8'):
+            c.query('get_frame_jacobians', self.body, self.q[0], reference=[1])
+        for empty in (np.zeros((0, len(self.q[0]))), np.zeros((3, 0))):
+            with self.assertRaisesRegex(ValueError, r'get_mass_matrix: q: at least one configuration'):
+                c.query('get_mass_matrix', self.body, empty)
         with self.assertRaisesRegex(ValueError, r"'get_state' is not a state-free service"):
             c.query('get_state')
         with self.assertRaisesRegex(DiffRigidBodyError, r"unknown frame 'no_such_link'"):
