@@ -58,12 +58,13 @@ inline std::size_t dynamicsConfigurations(std::size_t D, std::size_t bodies,
                                    DoubleView q,
                                    std::initializer_list<std::pair<const char*, const DoubleView*>> others)
 {
-  if (!q.empty() && (bodies == 0 || q.size() % D != 0))
+  // K = q.size() / D; one configuration, the usual call, needs no division.
+  const std::size_t configurations = q.empty() || q.size() == D ? 1 : D == 0 ? 0 : q.size() / D;
+  if (!q.empty() && (bodies == 0 || configurations * D != q.size()))
     detail::reject(detail::sizeMismatch("q",
                         "a multiple of " + std::to_string(D) + " values (the sum of the " +
                             std::to_string(bodies) + " bodies' dofs), or empty for the current state",
                         q.size()));
-  const std::size_t configurations = q.empty() ? 1 : q.size() / D;
   requireFinite(q.data(), q.size(), "q");
   for (const auto& [field, values] : others)
   {
@@ -99,13 +100,21 @@ inline BatchedBodies batchedBodies(const SceneQueries& queries, const std::vecto
   return { indices, layout, dynamicsConfigurations(layout.D, indices.size(), q, others) };
 }
 
+/// Whether `configurations` x `per_configuration` answer values fit in
+/// `budget` (a product that overflows does not).
+inline bool withinBudget(std::size_t configurations, std::size_t per_configuration, std::size_t budget)
+{
+  std::size_t values = 0;
+  return !__builtin_mul_overflow(configurations, per_configuration, &values) && values <= budget;
+}
+
 /// Refuses an answer of more doubles than the budget of get_mass_matrix
 /// (with matrices: its budget with derivatives).
 inline void checkDynamicsBudget(std::size_t configurations, std::size_t per_configuration, bool matrices)
 {
   const std::size_t budget =
       matrices ? RequestLimits::kMaxMassMatrixDoublesWithDerivatives : RequestLimits::kMaxMassMatrixDoubles;
-  if (per_configuration == 0 || configurations <= budget / per_configuration)
+  if (withinBudget(configurations, per_configuration, budget))
     return;
   std::ostringstream why;
   why << "q: expected at most " << budget << " answer values, got " << configurations << " configuration(s) x "

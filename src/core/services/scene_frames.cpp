@@ -189,9 +189,13 @@ void SceneQueries::frameJacobians(const SceneState& current, const std::string& 
   checkDynamicsBudget(K, F * (12 + 6 * d + (acceleration_bias ? 6 : 0)) + 1, true);
   answer.frames.resize(F);
   for (std::size_t f = 0; f < F; ++f)
-    answer.frames[f] = !slots[f].fixed                 ? body.links[slots[f].index].name
-                       : slots[f].index == kFixedFrame ? scene_.fixed_frame
-                                                       : scene_.static_links[slots[f].index].name;
+  {
+    const std::string& name = !slots[f].fixed                 ? body.links[slots[f].index].name
+                              : slots[f].index == kFixedFrame ? scene_.fixed_frame
+                                                              : scene_.static_links[slots[f].index].name;
+    if (answer.frames[f] != name)  // a reused answer usually holds it already
+      answer.frames[f] = name;
+  }
   answer.dofs = static_cast<std::uint32_t>(d);
   answer.poses.resize(K * F * 12);
   answer.jacobians.resize(K * F * 6 * d);

@@ -95,7 +95,7 @@ void SceneQueries::checkMassMatrixBudget(std::size_t configurations, std::size_t
   // this is "configurations x bodies <= kMaxMassMatrices(WithDerivatives)".
   const std::size_t budget =
       derivatives ? RequestLimits::kMaxMassMatrixDoublesWithDerivatives : RequestLimits::kMaxMassMatrixDoubles;
-  if (per_configuration == 0 || configurations <= budget / per_configuration)
+  if (detail::withinBudget(configurations, per_configuration, budget))
     return;
   if (all_six)
   {
