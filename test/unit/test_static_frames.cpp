@@ -93,4 +93,23 @@ TEST(StaticFrames, ARequestAfterAnotherSceneOrOptionGetsAFreshThreadsAnswer)
     EXPECT_EQ(kept.poses[2], queries == &low ? 0.5 : 0.7);  // the table's height in this scene
   }
 }
+// A reused answer (the node keeps one per thread) holds each request's frame names and values,
+// whatever the request before it named: more frames, fewer, or the same in another order.
+TEST(StaticFrames, AReusedAnswerHoldsEachRequestsFrames)
+{
+  const drb::SceneQueries queries(drb::loadSceneFromUrdf(kTableScene, drb::SceneOptions()), drb::standardGravity());
+  const std::vector<double> q{ 0.3, -0.2, 0.1, 0.4, 0.5, 1.6 };
+  drb::FrameJacobianAnswer reused;
+  for (const std::vector<std::string>& frames :
+       std::vector<std::vector<std::string>>{ { "table", "world", "box" }, { "box", "table" }, { "world" },
+                                              { "box", "world", "table" }, { "box" } })
+  {
+    drb::FrameJacobianAnswer fresh;
+    queries.frameJacobians(queries.initialState(), "box", frames, q, {}, 2, false, reused);
+    queries.frameJacobians(queries.initialState(), "box", frames, q, {}, 2, false, fresh);
+    EXPECT_EQ(reused.frames, frames);
+    EXPECT_EQ(reused.poses, fresh.poses);
+    EXPECT_EQ(reused.jacobians, fresh.jacobians);
+  }
+}
 }  // namespace
