@@ -249,6 +249,14 @@ inline void forwardKinematicsOf(const BodyModel& model, BodyWorkspace<double>& w
   detail::placeSegments(model, ws, x, [&](std::size_t s) { return needed[s] != 0; });
 }
 
+/// cos(theta) of a free root at the x of ws's last forwardKinematics(Of)
+/// (the middle one of its three angle slots, after the revolute joints'); 1
+/// for a fixed base.
+inline double rootCosTheta(const BodyModel& model, const BodyWorkspace<double>& ws)
+{
+  return model.hasFreeRoot() ? ws.joint_cosine[model.revolute_segments.size() + (THETA - PHI)] : 1.0;
+}
+
 /// Whether every frame, unit motion and the reference point are finite (a
 /// prismatic joint at 1e308 overflows them).
 bool kinematicsAreFinite(const BodyModel& model, const BodyWorkspace<double>& ws);

@@ -222,7 +222,7 @@ void SceneQueries::frameJacobians(const SceneState& current, const std::string& 
         frameJacobian(body, ws, slots[f].index, ref, answer.poses.data() + 12 * n,
                       answer.jacobians.data() + 6 * d * n, bias);
     }
-    answer.cos_theta[k] = body.hasFreeRoot() ? std::cos(x[THETA]) : 1.0;
+    answer.cos_theta[k] = rootCosTheta(body, ws);
   }
   detail::requireFiniteResults({ { "result poses", &answer.poses },
                          { "result jacobians", &answer.jacobians },
