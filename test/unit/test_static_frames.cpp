@@ -6,11 +6,13 @@
 #include <cstdint>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "diff_rigid_body/services/scene_queries.h"
+#include "../support/plumbing_scenes.h"
 #include "../support/urdf_builders.h"
 
 namespace drb = diff_rigid_body;
@@ -93,6 +95,35 @@ TEST(StaticFrames, ARequestAfterAnotherSceneOrOptionGetsAFreshThreadsAnswer)
     EXPECT_EQ(kept.poses[2], queries == &low ? 0.5 : 0.7);  // the table's height in this scene
   }
 }
+// Each thread keeps its last frame request's workspace too: requests that alternate between
+// bodies of 9, 2 and 6 coordinates on one scene, by the same thread, must each get the answer a
+// fresh thread gets, bit for bit.
+TEST(StaticFrames, ARequestForAnotherBodyGetsAFreshThreadsAnswer)
+{
+  const drb::SceneQueries queries(drb_test::plumbing::scene());
+  const std::vector<std::pair<std::string, std::vector<double>>> requests{
+    { "arm", { 0.1, 0.2, 0.3, 1.0, 2.0, 3.0, 0.4, -0.5, 0.05 } },
+    { "crane", { 0.7, 0.25 } },
+    { "arm", { -0.3, 1.1, 0.2, 0.5, 0.0, -1.0, 1.2, 0.3, -0.1 } },
+    { "cube", { 0.3, -0.2, 0.1, 0.4, 0.5, 1.6 } },
+    { "crane", { -1.1, 0.6 } },
+  };
+  for (const auto& [body, q] : requests)
+  {
+    const std::vector<double> qdot(q.size(), 0.5);
+    auto ask = [&, &body = body, &q = q](drb::FrameJacobianAnswer& answer) {
+      queries.frameJacobians(queries.initialState(), body, {}, q, qdot, 0, true, answer);
+    };
+    drb::FrameJacobianAnswer kept, fresh;
+    ask(kept);
+    std::thread([&] { ask(fresh); }).join();
+    EXPECT_EQ(kept.frames, fresh.frames) << body;
+    EXPECT_EQ(kept.poses, fresh.poses) << body;
+    EXPECT_EQ(kept.jacobians, fresh.jacobians) << body;
+    EXPECT_EQ(kept.acceleration_bias, fresh.acceleration_bias) << body;
+  }
+}
+
 // A reused answer (the node keeps one per thread) holds each request's frame names and values,
 // whatever the request before it named: more frames, fewer, or the same in another order.
 TEST(StaticFrames, AReusedAnswerHoldsEachRequestsFrames)

@@ -1,7 +1,7 @@
 // SceneQueries::frameJacobians and centerOfMass: the requests' checks and
 // layout, and frame_jacobians.h per configuration.
 #include <algorithm>
-#include <cmath>
+#include <memory>
 #include <sstream>
 #include <unordered_map>
 
@@ -10,6 +10,7 @@
 #include "diff_rigid_body/services/scene_queries.h"
 #include "services/request_checks.h"
 #include "services/request_layout.h"
+#include "services/thread_scratch.h"
 
 namespace diff_rigid_body
 {
@@ -91,26 +92,31 @@ void frameSlots(const Scene& scene, std::size_t body_index, const std::vector<st
 }
 
 /// This thread's resolution of its last frameJacobians request: the body, the listed frames'
-/// slots and the segments whose placement they need. A request that names the same body and
-/// frames on the same scene reuses it (no name lookups); the needed segments are marked again
-/// only when the frames or the acceleration bias (which needs every segment) change.
+/// slots, the segments whose placement they need, and the body's workspace. A request that
+/// names the same body and frames on the same scene reuses it (no name lookups); the needed
+/// segments are marked again only when the frames or the acceleration bias (which needs every
+/// segment) change, the workspace only when the scene or the body does.
 class FrameScratch
 {
 public:
   std::size_t body_index = 0;
   std::vector<FrameSlot> slots;
+  std::unique_ptr<BodyWorkspace<double>> workspace;
 
   /// Unless this thread's previous request on scene `scene_id` named the same body and frames:
   /// body_index = resolve(slots), which fills the slots (and refuses unknown names).
   template <typename Resolve>
-  void lookUp(std::uint64_t scene_id, const std::string& body_name, const std::vector<std::string>& frames,
-              const Resolve& resolve)
+  void lookUp(std::uint64_t scene_id, const Scene& scene, const std::string& body_name,
+              const std::vector<std::string>& frames, const Resolve& resolve)
   {
     if (scene_id == scene_id_ && body_name == body_name_ && frames == frames_)
       return;
+    const bool same_body = scene_id == scene_id_ && body_name == body_name_;
     scene_id_ = 0;  // nothing is resolved until resolve() returns
     marked_ = false;
     body_index = resolve(slots);
+    if (!same_body || !workspace)
+      workspace = std::make_unique<BodyWorkspace<double>>(scene.bodies[body_index]);
     body_name_ = body_name;
     frames_ = frames;
     scene_id_ = scene_id;
@@ -136,14 +142,6 @@ private:
   std::vector<char> needed_;
   bool marked_ = false, every_segment_ = false;
 };
-
-/// This thread's FrameScratch. In a shared library each use of a thread_local's
-/// name may look it up again (__tls_get_addr); callers bind the reference once.
-[[gnu::noinline]] FrameScratch& threadFrameScratch()
-{
-  thread_local FrameScratch scratch;
-  return scratch;
-}
 
 FrameReference frameReference(std::uint32_t reference)
 {
@@ -174,8 +172,8 @@ void SceneQueries::frameJacobians(const SceneState& current, const std::string& 
                                   DoubleView qdot, std::uint32_t reference, bool acceleration_bias,
                                   FrameJacobianAnswer& answer) const
 {
-  FrameScratch& scratch = threadFrameScratch();
-  scratch.lookUp(id_, body_name, frames, [&](std::vector<FrameSlot>& slots) {
+  FrameScratch& scratch = detail::threadScratch<FrameScratch>();
+  scratch.lookUp(id_, scene_, body_name, frames, [&](std::vector<FrameSlot>& slots) {
     const std::size_t found = bodyIndex(body_name, "body");
     frameSlots(scene_, found, frames, link_index_, slots);
     return found;
@@ -201,7 +199,7 @@ void SceneQueries::frameJacobians(const SceneState& current, const std::string& 
   answer.jacobians.resize(K * F * 6 * d);
   answer.acceleration_bias.resize(acceleration_bias ? K * F * 6 : 0);
   answer.cos_theta.resize(K);
-  BodyWorkspace<double>& ws = workspace(index);
+  BodyWorkspace<double>& ws = *scratch.workspace;
   // Without the bias, only the listed frames' paths to the root are placed.
   const std::vector<char>& needed = scratch.needed(body, acceleration_bias);
   for (std::size_t k = 0; k < K; ++k)

@@ -11,6 +11,7 @@
 #include "diff_rigid_body/algorithm/kinematics.h"
 #include "diff_rigid_body/algorithm/vertex_backprop.h"
 #include "services/request_checks.h"
+#include "services/thread_scratch.h"
 
 namespace diff_rigid_body
 {
@@ -39,14 +40,6 @@ struct WorkspaceCache
   std::uint64_t owner = 0;
   std::vector<std::unique_ptr<BodyWorkspace<double>>> bodies;
 };
-
-/// This thread's cache, by one thread-local lookup (in a shared library each use
-/// of a thread_local's name may call __tls_get_addr again).
-[[gnu::noinline]] WorkspaceCache& threadWorkspaceCache()
-{
-  thread_local WorkspaceCache cache;
-  return cache;
-}
 }  // namespace
 
 SceneQueries::SceneQueries(Scene scene, const Eigen::Vector3d& gravity)
@@ -77,7 +70,7 @@ SceneQueries::SceneQueries(Scene scene, const Eigen::Vector3d& gravity)
 
 BodyWorkspace<double>& SceneQueries::workspace(std::size_t index) const
 {
-  WorkspaceCache& cache = threadWorkspaceCache();
+  WorkspaceCache& cache = detail::threadScratch<WorkspaceCache>();
   if (cache.owner != id_)
   {
     cache.owner = id_;
