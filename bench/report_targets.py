@@ -169,8 +169,7 @@ def issue29_targets(rows):
                faster("frame_jacobian", "kdl"), lambda v: v >= 1),
         target(rows, "Issue 29: the node's whole call (`SceneQueries::frameJacobians`, one frame) ≤ 1.2× the kernel "
                "it runs", ALL, lambda r: quotient(r.t("frame_jacobian", "node_call"), r.t("frame_jacobian", "ours")),
-               lambda v: v <= 1.2, why="the call's fixed cost (the request's checks, the frame and workspace lookups, the "
-               "answer's finiteness check, cos θ for a floating root) is 15-25% of a kernel this short, and a shared "
-               "machine moves the ratio by about 0.1 between runs; K configurations or several frames per call "
-               "amortise it"),
+               lambda v: v <= 1.2, why="the call's fixed cost (the request's checks, the frame lookup, the answer's finiteness "
+               "check) is 13-18% of a kernel this short, and a shared machine moves the ratio by about 0.1 between "
+               "runs; K configurations or several frames per call amortise it"),
     ]
