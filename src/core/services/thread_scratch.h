@@ -1,5 +1,5 @@
-// This thread's scratch object of a type: the reused buffers of the request
-// checks and the workspaces, one per thread, so that concurrent requests on
+// This thread's scratch object of a type (SceneQueries' workspace cache, the
+// frame requests' resolution): one per thread, so that concurrent requests on
 // one SceneQueries never share them.
 #pragma once
 
